@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages candela needs. Idempotent: when everything is present it only
+# queries dpkg and returns; it runs `apt-get update` only when something is missing.
+# Usage: bash scripts/setup.sh [--with-embree]
+set -euo pipefail
+pkgs=(
+  cmake ninja-build g++ pkg-config
+  libglfw3-dev libglm-dev libimgui-dev libtinyobjloader-dev libstb-dev
+  libosmesa6-dev libgl-dev libpugixml-dev libcli11-dev libtinyexr-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  xvfb xauth
+)
+for a in "$@"; do
+  case "$a" in
+    --with-embree) pkgs+=(libembree-dev) ;;
+    *) echo "setup.sh: unknown option '$a'" >&2; exit 2 ;;
+  esac
+done
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  exit 0
+fi
+echo "setup.sh: installing ${missing[*]}" >&2
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

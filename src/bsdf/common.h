@@ -1,0 +1,16 @@
+#pragma once
+#include "core/math.h"
+
+namespace candela {
+
+enum class TransportMode { Radiance, Importance };
+
+struct BsdfSample {
+    vec3 f{0.f};       // f * |cos theta_i| (see bsdf.h for delta lobes)
+    vec3 wi{0.f};      // sampled direction, local frame
+    float pdf = 0.f;   // solid-angle density, or the lobe's discrete probability for delta lobes
+    bool delta = false;
+    vec3 weight() const { return pdf > 0.f ? f / pdf : vec3(0.f); }
+};
+
+}  // namespace candela

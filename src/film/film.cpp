@@ -1,0 +1,69 @@
+#include "film/film.h"
+#include <mutex>
+
+namespace candela {
+
+void Film::resize(int width, int height) {
+    width_ = width;
+    height_ = height;
+    sum_.assign(size_t(width) * size_t(height), dvec3(0.0));
+    count_.assign(size_t(width) * size_t(height), 0u);
+    splat_.clear();
+    nonfinite_ = 0;
+}
+
+void Film::clear() { resize(width_, height_); }
+
+void Film::add_splat(vec2 film_pos, vec3 L) {
+    int x = int(film_pos.x), y = int(film_pos.y);
+    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+    if (!all_finite(L)) {
+        nonfinite_.fetch_add(1, std::memory_order_relaxed);
+        return;
+    }
+    // Splats arrive from any thread to any pixel; they are rare enough for a lock here, and
+    // bidirectional integrators buffer them per thread before calling this.
+    static std::mutex m;
+    std::lock_guard<std::mutex> lock(m);
+    if (splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
+    splat_[size_t(y) * size_t(width_) + size_t(x)] += dvec3(L);
+}
+
+vec3 Film::pixel(int x, int y) const {
+    size_t i = size_t(y) * size_t(width_) + size_t(x);
+    dvec3 v = count_[i] > 0 ? sum_[i] / double(count_[i]) : dvec3(0.0);
+    if (!splat_.empty()) v += splat_[i] * splat_scale_;
+    return vec3(v);
+}
+
+void Film::resolve_into(std::vector<float>& rgb) const {
+    rgb.resize(size_t(width_) * size_t(height_) * 3);
+    for (int y = 0; y < height_; ++y)
+        for (int x = 0; x < width_; ++x) {
+            vec3 v = pixel(x, y);
+            size_t i = (size_t(y) * size_t(width_) + size_t(x)) * 3;
+            rgb[i] = v.x;
+            rgb[i + 1] = v.y;
+            rgb[i + 2] = v.z;
+        }
+}
+
+std::vector<float> Film::resolve() const {
+    std::vector<float> rgb;
+    resolve_into(rgb);
+    return rgb;
+}
+
+uint64_t Film::total_samples() const {
+    uint64_t n = 0;
+    for (uint32_t c : count_) n += c;
+    return n;
+}
+
+void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite) {
+    sum_ = std::move(sums);
+    count_ = std::move(counts);
+    nonfinite_ = nonfinite;
+}
+
+}  // namespace candela

@@ -1,0 +1,60 @@
+#pragma once
+#include "core/frame.h"
+#include "core/ray.h"
+
+namespace candela {
+
+// What an accelerator reports: the closest triangle and where on it. The surface point is
+// rebuilt from the barycentrics (not o + t d), which keeps its error small and bounded.
+struct Hit {
+    float t = kInfinity;
+    float b1 = 0.f, b2 = 0.f;
+    uint32_t prim = ~0u;
+};
+
+// A point on a surface with what shading needs. p_error bounds |p - exact point| per axis.
+struct SurfaceInteraction {
+    vec3 p{0.f};
+    vec3 p_error{0.f};
+    vec3 ng{0.f, 0.f, 1.f};  // geometric normal, normalised, from the triangle's winding
+    vec3 ns{0.f, 0.f, 1.f};  // shading normal (interpolated vertex normal, or ng)
+    uint32_t prim = ~0u;
+    uint32_t shape = ~0u;
+};
+
+// Offsets p along the normal by the point's error bound, on the side of w, then rounds away from
+// the surface (pbrt-v4 OffsetRayOrigin). The offset scales with the coordinates themselves, so it
+// works at any scene scale, unlike a fixed epsilon.
+inline vec3 offset_ray_origin(vec3 p, vec3 p_error, vec3 n, vec3 w) {
+    float d = glm::dot(glm::abs(n), p_error);
+    vec3 offset = d * n;
+    if (glm::dot(w, n) < 0.f) offset = -offset;
+    vec3 po = p + offset;
+    for (int i = 0; i < 3; ++i) {
+        if (offset[i] > 0.f) po[i] = next_float_up(po[i]);
+        else if (offset[i] < 0.f) po[i] = next_float_down(po[i]);
+    }
+    return po;
+}
+
+// A ray leaving the surface in direction w (any length).
+inline Ray spawn_ray(const SurfaceInteraction& si, vec3 w) {
+    Ray r;
+    r.o = offset_ray_origin(si.p, si.p_error, si.ng, w);
+    r.d = w;
+    return r;
+}
+
+// Both ends offset: for shadow rays between two surface points. tmax stops just short of the
+// (offset) target so that the target's own surface is never reported as an occluder.
+constexpr float kShadowEpsilon = 1e-4f;
+inline Ray spawn_ray_to(const SurfaceInteraction& from, vec3 to_p, vec3 to_error, vec3 to_n) {
+    Ray r;
+    r.o = offset_ray_origin(from.p, from.p_error, from.ng, to_p - from.p);
+    vec3 pt = offset_ray_origin(to_p, to_error, to_n, r.o - to_p);
+    r.d = pt - r.o;
+    r.tmax = 1.f - kShadowEpsilon;
+    return r;
+}
+
+}  // namespace candela

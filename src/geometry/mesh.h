@@ -1,0 +1,54 @@
+#pragma once
+#include <string>
+#include <vector>
+#include "core/aabb.h"
+#include "core/math.h"
+
+namespace candela {
+
+// All the scene's triangles in world space, in one indexed array: accelerators see one list of
+// primitives (the triangle index is the primitive id) and never chase pointers to per-shape meshes.
+// A Shape is a contiguous run of triangles that share a material and an emitter.
+struct Mesh {
+    std::vector<vec3> positions;
+    std::vector<vec3> normals;       // per vertex; empty, or the same size as positions
+    std::vector<uvec3> triangles;    // vertex indices
+    std::vector<uint32_t> tri_shape; // shape index of each triangle
+
+    size_t triangle_count() const { return triangles.size(); }
+    void vertices(uint32_t tri, vec3& p0, vec3& p1, vec3& p2) const {
+        const uvec3& t = triangles[tri];
+        p0 = positions[t.x];
+        p1 = positions[t.y];
+        p2 = positions[t.z];
+    }
+    AABB triangle_bounds(uint32_t tri) const {
+        vec3 a, b, c;
+        vertices(tri, a, b, c);
+        AABB box(a, a);
+        box.expand(b);
+        box.expand(c);
+        return box;
+    }
+    float triangle_area(uint32_t tri) const {
+        vec3 a, b, c;
+        vertices(tri, a, b, c);
+        return 0.5f * glm::length(glm::cross(b - a, c - a));
+    }
+    AABB bounds() const {
+        AABB box;
+        for (const vec3& p : positions) box.expand(p);
+        return box;
+    }
+};
+
+struct Shape {
+    std::string name;          // for messages and the viewer's pick readout
+    uint32_t material = 0;     // index into Scene::materials
+    int32_t emitter = -1;      // index into Scene::emitters, or -1
+    bool smooth = false;       // interpolate vertex normals (else the face normal shades)
+    uint32_t first_triangle = 0;
+    uint32_t triangle_count = 0;
+};
+
+}  // namespace candela

@@ -1,0 +1,65 @@
+#pragma once
+// Watertight ray-triangle intersection (Woop, Benthin, Wald 2013, "Watertight ray/triangle
+// intersection"; the same as pbrt-v4's Triangle::Intersect). The ray is sheared so that it runs
+// along +z; edge functions are then evaluated in 2D. A ray through a shared edge or vertex gives
+// the same edge function values (up to sign) for both triangles, so it hits at least one of them
+// and never slips between. Edge functions that round to exactly 0 are redone in double.
+#include "core/ray.h"
+
+namespace candela {
+
+// Per-ray constants of the shear; computed once per ray and reused for every triangle tested.
+struct RayShear {
+    int kx, ky, kz;
+    float sx, sy, sz;
+    explicit RayShear(vec3 d) {
+        kz = max_dimension(glm::abs(d));
+        kx = kz + 1 == 3 ? 0 : kz + 1;
+        ky = kx + 1 == 3 ? 0 : kx + 1;
+        sx = -d[kx] / d[kz];
+        sy = -d[ky] / d[kz];
+        sz = 1.f / d[kz];
+    }
+};
+
+struct TriangleHit {
+    float t;
+    float b1, b2;  // barycentrics of p1 and p2; p = (1-b1-b2) p0 + b1 p1 + b2 p2
+};
+
+// Returns true and fills `hit` when the ray meets the triangle with tmin < t < tmax.
+inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3 p1, vec3 p2, TriangleHit& hit) {
+    // Translate to the ray origin and permute so that the largest direction component is z.
+    vec3 a = p0 - ray.o, b = p1 - ray.o, c = p2 - ray.o;
+    float ax = a[sh.kx] + sh.sx * a[sh.kz], ay = a[sh.ky] + sh.sy * a[sh.kz];
+    float bx = b[sh.kx] + sh.sx * b[sh.kz], by = b[sh.ky] + sh.sy * b[sh.kz];
+    float cx = c[sh.kx] + sh.sx * c[sh.kz], cy = c[sh.ky] + sh.sy * c[sh.kz];
+
+    float e0 = bx * cy - by * cx;
+    float e1 = cx * ay - cy * ax;
+    float e2 = ax * by - ay * bx;
+    if (e0 == 0.f || e1 == 0.f || e2 == 0.f) {
+        e0 = float(double(bx) * double(cy) - double(by) * double(cx));
+        e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
+        e2 = float(double(ax) * double(by) - double(ay) * double(bx));
+    }
+    if ((e0 < 0.f || e1 < 0.f || e2 < 0.f) && (e0 > 0.f || e1 > 0.f || e2 > 0.f)) return false;
+    float det = e0 + e1 + e2;
+    if (det == 0.f) return false;
+
+    float az = sh.sz * a[sh.kz], bz = sh.sz * b[sh.kz], cz = sh.sz * c[sh.kz];
+    float t_scaled = e0 * az + e1 * bz + e2 * cz;
+    // Compare t against [tmin, tmax] without dividing: the signs follow det's.
+    if (det < 0.f && (t_scaled >= ray.tmin * det || t_scaled <= ray.tmax * det)) return false;
+    if (det > 0.f && (t_scaled <= ray.tmin * det || t_scaled >= ray.tmax * det)) return false;
+
+    float inv_det = 1.f / det;
+    float t = t_scaled * inv_det;
+    if (!(t > ray.tmin && t < ray.tmax)) return false;  // rounding, and NaN from degenerate input
+    hit.t = t;
+    hit.b1 = e1 * inv_det;
+    hit.b2 = e2 * inv_det;
+    return true;
+}
+
+}  // namespace candela

@@ -1,0 +1,35 @@
+#pragma once
+#include "scene/scene.h"
+#include "sampling/sampler.h"
+
+namespace candela {
+
+struct PathStats {
+    uint64_t rays = 0;  // closest-hit and shadow rays traced
+};
+
+// Unidirectional path tracing with next-event estimation, combined with BSDF sampling by the
+// power heuristic (Veach 1997) in Mis mode. Light mode counts emission only through light
+// sampling (and after delta bounces); Bsdf mode only through BSDF-sampled rays. All three estimate
+// the same radiance.
+//
+// Depth: `max_depth` counts scattering events (0: emitters seen directly, 1: direct lighting).
+// At a vertex reached after k scattering events, emission is added (a path of k events) and, when
+// k < max_depth, a light sample (a path of k + 1 events) and a BSDF sample for the next vertex.
+// Russian roulette starts once k >= rr_depth, with survival probability min(max(beta), 0.95).
+class PathIntegrator {
+public:
+    explicit PathIntegrator(const Scene& scene) : scene_(scene) {}
+
+    // Radiance arriving along the camera ray (towards -ray.d). Template on the sampler so that the
+    // independent sampler's calls are inlined; MLT instantiates it with its own sampler.
+    template <class S>
+    vec3 Li(Ray ray, S& sampler, PathStats& stats) const;
+
+private:
+    const Scene& scene_;
+};
+
+}  // namespace candela
+
+#include "integrator/path_impl.h"

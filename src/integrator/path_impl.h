@@ -1,0 +1,100 @@
+#pragma once
+// The path tracer's inner loop (included by path.h; kept apart for readability).
+
+namespace candela {
+
+inline float power_heuristic(float a, float b) {
+    float a2 = a * a, b2 = b * b;
+    if (std::isinf(a2)) return 1.f;
+    return a2 + b2 > 0.f ? a2 / (a2 + b2) : 0.f;
+}
+
+template <class S>
+vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
+    const Scene& sc = scene_;
+    const RenderSettings& st = sc.settings;
+    const SamplingMode mode = st.sampling;
+    const bool have_lights = !sc.lights.empty();
+    vec3 L(0.f), beta(1.f);
+    bool after_delta = true;     // camera rays and delta bounces: emission always counts fully
+    float prev_pdf = 0.f;        // solid-angle pdf of the BSDF sample that led here
+    vec3 prev_p(0.f);
+
+    for (int depth = 0;; ++depth) {
+        Hit hit;
+        ++stats.rays;
+        if (!sc.accel->intersect(ray, hit)) break;  // no environment emitter (yet)
+        SurfaceInteraction si = sc.interaction(hit);
+        vec3 wo_world = -glm::normalize(ray.d);
+
+        // Emission reached by this ray.
+        if (sc.lights.emitter_of(hit.prim) >= 0) {
+            vec3 Le = sc.lights.emitted(si, wo_world);
+            if (!is_black(Le)) {
+                if (after_delta || mode == SamplingMode::Bsdf) {
+                    L += beta * Le;
+                } else if (mode == SamplingMode::Mis) {
+                    float light_pdf = sc.lights.pdf_li(prev_p, si);
+                    L += beta * Le * power_heuristic(prev_pdf, light_pdf);
+                }  // Light mode: this path was already counted by light sampling.
+            }
+        }
+        if (st.max_depth >= 0 && depth >= st.max_depth) break;
+
+        const Shape& shape = sc.shapes[si.shape];
+        const Material& mat = sc.materials[shape.material];
+        // Shading frame; a two-sided material is seen from whichever side the ray arrives.
+        vec3 n = si.ns;
+        if (mat.two_sided && glm::dot(wo_world, n) < 0.f) {
+            n = -n;
+            si.ng = -si.ng;
+        }
+        Frame frame(n);
+        vec3 wo = frame.to_local(wo_world);
+
+        // Next-event estimation.
+        if (mode != SamplingMode::Bsdf && have_lights && has_smooth_component(mat.bsdf)) {
+            float ul = sampler.next_1d();
+            vec2 up = sampler.next_2d();
+            LightSample ls;
+            if (sc.lights.sample_li(si.p, ul, up, ls)) {
+                vec3 wi = frame.to_local(ls.wi);
+                vec3 f = eval(mat.bsdf, wo, wi);
+                if (!is_black(f)) {
+                    Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
+                    ++stats.rays;
+                    if (!sc.accel->occluded(shadow)) {
+                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, pdf(mat.bsdf, wo, wi)) : 1.f;
+                        L += beta * f * ls.Le * (w / ls.pdf);
+                    }
+                }
+            }
+        } else if (mode != SamplingMode::Bsdf) {
+            // Keep the sample dimensions aligned whatever the material (helps MLT and QMC later).
+            sampler.next_1d();
+            sampler.next_2d();
+        }
+
+        // Continue the path by sampling the BSDF.
+        float u1 = sampler.next_1d();
+        vec2 u2 = sampler.next_2d();
+        std::optional<BsdfSample> bs = sample(mat.bsdf, wo, u1, u2);
+        if (!bs || !(bs->pdf > 0.f)) break;
+        beta *= bs->weight();
+        if (is_black(beta)) break;
+        after_delta = bs->delta;
+        prev_pdf = bs->pdf;
+        prev_p = si.p;
+        vec3 wi_world = frame.to_world(bs->wi);
+        ray = spawn_ray(si, wi_world);
+
+        if (depth + 1 >= st.rr_depth) {
+            float q = std::min(max_component(beta), 0.95f);
+            if (sampler.next_1d() >= q) break;
+            beta /= q;
+        }
+    }
+    return L;
+}
+
+}  // namespace candela

@@ -1,0 +1,51 @@
+#include "render/renderer.h"
+#include <omp.h>
+#include "integrator/path.h"
+
+namespace candela {
+
+PassStats Renderer::render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
+                                const std::atomic<bool>* cancel) {
+    const int w = film.width(), h = film.height();
+    const int tiles_x = (w + kTileSize - 1) / kTileSize;
+    const int tiles_y = (h + kTileSize - 1) / kTileSize;
+    const int n_tiles = tiles_x * tiles_y;
+    const int n_threads = threads > 0 ? threads : omp_get_max_threads();
+    PathIntegrator integrator(scene);
+    std::atomic<uint64_t> total_rays{0}, total_samples{0};
+    std::atomic<bool> stopped{false};
+
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+    for (int tile = 0; tile < n_tiles; ++tile) {
+        if (stopped.load(std::memory_order_relaxed)) continue;
+        if (cancel && cancel->load(std::memory_order_relaxed)) {
+            stopped = true;
+            continue;
+        }
+        IndependentSampler sampler(scene.settings.seed);
+        PathStats ps;
+        uint64_t samples = 0;
+        const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+        const int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                for (int s = 0; s < spp; ++s) {
+                    sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
+                    vec2 jitter = sampler.next_2d();  // box filter: uniform over the pixel
+                    Ray ray = scene.camera.generate_ray(vec2(float(x), float(y)) + jitter);
+                    vec3 L = integrator.Li(ray, sampler, ps);
+                    film.add_sample(ivec2(x, y), L);
+                    ++samples;
+                }
+            }
+        total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
+        total_samples.fetch_add(samples, std::memory_order_relaxed);
+    }
+    PassStats out;
+    out.rays = total_rays.load();
+    out.samples = total_samples.load();
+    out.completed = !stopped.load();
+    return out;
+}
+
+}  // namespace candela

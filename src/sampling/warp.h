@@ -1,0 +1,64 @@
+#pragma once
+// Warps from the unit square [0,1)^2 to other domains, each with the density it produces.
+// Densities are with respect to the natural measure of the target: area for disks and triangles,
+// solid angle for directions. Every warp is chi-square tested against its pdf (tests/test_warp.cpp).
+#include "core/math.h"
+
+namespace candela {
+
+// Shirley-Chiu concentric map: low distortion, continuous, area-preserving up to a constant.
+inline vec2 square_to_uniform_disk_concentric(vec2 u) {
+    vec2 o = 2.f * u - vec2(1.f);
+    if (o.x == 0.f && o.y == 0.f) return vec2(0.f);
+    float r, theta;
+    if (std::abs(o.x) > std::abs(o.y)) {
+        r = o.x;
+        theta = (kPi / 4.f) * (o.y / o.x);
+    } else {
+        r = o.y;
+        theta = (kPi / 2.f) - (kPi / 4.f) * (o.x / o.y);
+    }
+    return r * vec2(std::cos(theta), std::sin(theta));
+}
+inline float square_to_uniform_disk_pdf(vec2 p) { return glm::dot(p, p) <= 1.f ? kInvPi : 0.f; }
+
+// Cosine-weighted hemisphere about +z (Malley's method); pdf = cos(theta) / pi per steradian.
+inline vec3 square_to_cosine_hemisphere(vec2 u) {
+    vec2 d = square_to_uniform_disk_concentric(u);
+    float z = safe_sqrt(1.f - d.x * d.x - d.y * d.y);
+    return vec3(d.x, d.y, z);
+}
+inline float square_to_cosine_hemisphere_pdf(vec3 v) { return v.z > 0.f ? v.z * kInvPi : 0.f; }
+
+inline vec3 square_to_uniform_sphere(vec2 u) {
+    float z = 1.f - 2.f * u.x;
+    float r = safe_sqrt(1.f - z * z);
+    float phi = 2.f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+inline float square_to_uniform_sphere_pdf(vec3) { return kInv4Pi; }
+
+inline vec3 square_to_uniform_hemisphere(vec2 u) {
+    float z = u.x;
+    float r = safe_sqrt(1.f - z * z);
+    float phi = 2.f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+inline float square_to_uniform_hemisphere_pdf(vec3 v) { return v.z >= 0.f ? kInv2Pi : 0.f; }
+
+// Uniform point on a triangle as barycentrics (b0, b1, b2 = 1 - b0 - b1). This is the low-
+// distortion map of Heitz 2019 ("A low-distortion map between triangle and square"): it keeps
+// stratification better than the square-root map. Density 1 / area on the triangle.
+inline vec2 square_to_uniform_triangle(vec2 u) {
+    float b0, b1;
+    if (u.x < u.y) {
+        b0 = u.x / 2.f;
+        b1 = u.y - b0;
+    } else {
+        b1 = u.y / 2.f;
+        b0 = u.x - b1;
+    }
+    return vec2(b0, b1);
+}
+
+}  // namespace candela

@@ -1,0 +1,1 @@
+// Statistical test helpers (chi-square, z-tests); see stats.h.
