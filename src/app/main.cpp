@@ -1,3 +1,103 @@
-// Placeholder entry point; the command line is being written (see src/app).
-#include "scene/cornell.h"
-int main() { return 0; }
+// candela's command line: parses options, then runs the viewer (when there is a display and no
+// --out) or a headless render that writes an image.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include "app/headless_run.h"
+#include "core/error.h"
+#ifdef CANDELA_HAS_VIEWER
+#include "viewer/viewer.h"
+#endif
+
+using namespace candela;
+
+int main(int argc, char** argv) {
+    CLI::App app{"candela: an interactive, progressive path tracer for the CPU.\n"
+                 "With no SCENE it renders the built-in Cornell box. With --out it renders headless;\n"
+                 "otherwise it opens the viewer when a display is available."};
+    HeadlessOptions opt;
+    SceneOverrides& ov = opt.overrides;
+    std::vector<std::string> defines;
+    int width = 0, height = 0, max_depth = -2, rr_depth = -2;
+    uint64_t seed = 0;
+    std::string sampling;
+    app.add_option("scene", opt.scene, "Scene file: Mitsuba 3 XML subset (.xml) or OBJ+MTL (.obj)");
+    app.add_option("--frames", opt.frames, "Passes to render (default: the scene's sample_count / spp-per-frame)")
+        ->check(CLI::Range(1, 1 << 30));
+    app.add_option("--spp-per-frame", opt.spp_per_frame, "Samples per pixel in each pass")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--out", opt.out, "Write the image and exit: .png (sRGB through the display shaders), .exr or .pfm (linear)");
+    auto* w_opt = app.add_option("--width", width, "Image width in pixels (overrides the scene)");
+    auto* h_opt = app.add_option("--height", height, "Image height in pixels (overrides the scene)");
+    auto* d_opt = app.add_option("--max-depth", max_depth, "Scattering events per path: 0 emitters only, 1 direct light, -1 unbounded");
+    auto* r_opt = app.add_option("--rr-depth", rr_depth, "Scattering events before Russian roulette starts");
+    auto* s_opt = app.add_option("--seed", seed, "Sampler seed (overrides the scene)");
+    app.add_option("--threads", opt.threads, "Render threads (default: all cores)")->check(CLI::Range(0, 1024));
+    app.add_option("--time-limit", opt.time_limit, "Stop after this many seconds (the image has the passes done by then)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--exposure", opt.display.exposure, "Exposure in stops for PNG output and the viewer");
+    app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
+    auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
+    app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
+    app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
+    std::string screenshot;
+    int screenshot_after = 0;
+    auto* shot = app.add_option("--screenshot-after", screenshot_after, "Viewer: render N passes, then save the window")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--screenshot", screenshot, "Viewer: PNG file for --screenshot-after");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "candela: %s (see --help)\n", e.what());
+        return 2;
+    }
+
+    try {
+        for (const std::string& d : defines) {
+            size_t eq = d.find('=');
+            if (eq == std::string::npos || eq == 0) throw Error("-D expects name=value, got '" + d + "'");
+            ov.defines.emplace_back(d.substr(0, eq), d.substr(eq + 1));
+        }
+        if (*w_opt) ov.width = width;
+        if (*h_opt) ov.height = height;
+        if (*d_opt) ov.max_depth = max_depth;
+        if (*r_opt) ov.rr_depth = rr_depth;
+        if (*s_opt) ov.seed = seed;
+        if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
+
+        bool has_display = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
+#ifdef CANDELA_HAS_VIEWER
+        if (opt.out.empty() && (has_display || *shot)) {
+            ViewerOptions vo;
+            vo.scene = opt.scene;
+            vo.overrides = ov;
+            vo.threads = opt.threads;
+            vo.display = opt.display;
+            vo.spp_per_frame = opt.spp_per_frame;
+            vo.screenshot_after = screenshot_after;
+            vo.screenshot = screenshot;
+            return run_viewer(vo);
+        }
+#else
+        (void)shot;
+#endif
+        if (opt.out.empty()) {
+            opt.out = "candela.png";
+            if (!opt.quiet)
+                std::fprintf(stderr, "candela: %s; rendering headless to %s\n",
+                             has_display ? "built without the viewer" : "no display", opt.out.c_str());
+        }
+        return run_headless(opt);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "candela: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "candela: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "candela: internal error: %s\n", e.what());
+        return 1;
+    }
+}

@@ -67,3 +67,25 @@ void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64
 }
 
 }  // namespace candela
+
+#include <unistd.h>
+#include "core/error.h"
+
+namespace candela {
+
+void check_film_size(int width, int height, const std::string& where) {
+    if (width <= 0 || height <= 0)
+        throw Error(where, 0, "image size must be positive, got " + std::to_string(width) + "x" + std::to_string(height));
+    // Sums (24 B), counts (4 B), the resolved float image (12 B) and the display copy (12 B).
+    double bytes = double(width) * double(height) * 52.0;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    double ram = pages > 0 && page > 0 ? double(pages) * double(page) : 8e9;
+    if (bytes > 0.5 * ram || width > (1 << 20) || height > (1 << 20)) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "image size %dx%d needs %.1f GB, more than half of this machine's %.1f GB",
+                      width, height, bytes / 1e9, ram / 1e9);
+        throw Error(where, 0, buf);
+    }
+}
+
+}  // namespace candela

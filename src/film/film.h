@@ -1,5 +1,6 @@
 #pragma once
 #include <atomic>
+#include <string>
 #include <vector>
 #include "core/math.h"
 
@@ -63,4 +64,10 @@ private:
     std::atomic<uint64_t> nonfinite_{0};
 };
 
+}  // namespace candela
+
+namespace candela {
+// Throws Error when a film of this size cannot exist: a non-positive size, or more memory than
+// half of this machine's RAM. Called before anything is allocated. `where` names the source.
+void check_film_size(int width, int height, const std::string& where);
 }  // namespace candela

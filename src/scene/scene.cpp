@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 #include "core/error.h"
+#include "film/film.h"
 
 namespace candela {
 
@@ -36,9 +37,7 @@ void Scene::finalize(const std::string& accel_name) {
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
             throw Error(source, 0, "triangle index out of range");
     if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
-    if (settings.width <= 0 || settings.height <= 0)
-        throw Error(source, 0, "image size must be positive, got " + std::to_string(settings.width) + "x" +
-                                   std::to_string(settings.height));
+    check_film_size(settings.width, settings.height, source);
     camera.set_film_size(settings.width, settings.height);
     accel = make_accel(accel_name, mesh);
     lights.build(mesh, shapes, emitters);

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Configures and builds candela. Usage: bash scripts/build.sh [--sanitize] [--embree] [--debug]
+# Release build in build/ (ASan+UBSan build in build-asan/ with --sanitize).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+dir=build
+type=Release
+extra=()
+for a in "$@"; do
+  case "$a" in
+    --sanitize) dir=build-asan; type=RelWithDebInfo; extra+=(-DCANDELA_SANITIZE=ON) ;;
+    --embree) extra+=(-DCANDELA_EMBREE=ON) ;;
+    --debug) dir=build-debug; type=Debug ;;
+    *) echo "build.sh: unknown option '$a'" >&2; exit 2 ;;
+  esac
+done
+if [ ! -f "$dir/build.ninja" ]; then
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" "${extra[@]}" >/dev/null
+elif [ "${#extra[@]}" -gt 0 ]; then
+  cmake "$dir" "${extra[@]}" >/dev/null
+fi
+cmake --build "$dir" -j"$(nproc)" >&2
+echo "$dir"

@@ -1,0 +1,37 @@
+#include "render/launch.h"
+#include "core/error.h"
+#include "scene/cornell.h"
+
+namespace candela {
+
+Scene prepare_scene(const std::string& path, const SceneOverrides& ov) {
+    Scene scene = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
+    RenderSettings& st = scene.settings;
+    if (ov.width) st.width = *ov.width;
+    if (ov.height) st.height = *ov.height;
+    if (ov.max_depth) st.max_depth = *ov.max_depth;
+    if (ov.rr_depth) st.rr_depth = *ov.rr_depth;
+    if (ov.seed) st.seed = *ov.seed;
+    if (ov.sampling) st.sampling = *ov.sampling;
+    if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
+    if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
+    scene.finalize(ov.accel);
+    return scene;
+}
+
+SamplingMode parse_sampling_mode(const std::string& s) {
+    if (s == "light") return SamplingMode::Light;
+    if (s == "bsdf") return SamplingMode::Bsdf;
+    if (s == "mis") return SamplingMode::Mis;
+    throw Error("unknown sampling mode '" + s + "' (expected light, bsdf or mis)");
+}
+
+const char* sampling_mode_name(SamplingMode m) {
+    switch (m) {
+        case SamplingMode::Light: return "light";
+        case SamplingMode::Bsdf: return "bsdf";
+        default: return "mis";
+    }
+}
+
+}  // namespace candela

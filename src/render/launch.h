@@ -1,0 +1,26 @@
+#pragma once
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+#include "scene/scene.h"
+
+namespace candela {
+
+// What the command line may override in a scene. Unset fields keep the scene file's values.
+struct SceneOverrides {
+    std::vector<std::pair<std::string, std::string>> defines;  // -D name=value
+    std::optional<int> width, height, max_depth, rr_depth;
+    std::optional<uint64_t> seed;
+    std::optional<SamplingMode> sampling;
+    std::string accel = "auto";
+};
+
+// Loads `path` (or the built-in Cornell box when empty), applies the overrides and finalises the
+// scene (accelerator, lights, camera). Throws Error with file:line on bad input.
+Scene prepare_scene(const std::string& path, const SceneOverrides& ov);
+
+SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
+const char* sampling_mode_name(SamplingMode m);
+
+}  // namespace candela
