@@ -1,0 +1,502 @@
+#include "accel/kdtree.h"
+#include <omp.h>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include "geometry/triangle.h"
+
+namespace candela {
+namespace {
+
+// ---- build ----------------------------------------------------------------------------------
+
+// Wald-Havran event types; the order end < planar < start is the sweep's tie order at one position.
+enum : uint8_t { kEnd = 0, kPlanar = 1, kStart = 2 };
+
+struct Event {
+    float pos;
+    uint32_t tri;  // index into the builder's triangle list (not the mesh's)
+    uint8_t dim, type;
+    bool operator<(const Event& o) const {
+        if (pos != o.pos) return pos < o.pos;
+        if (dim != o.dim) return dim < o.dim;
+        return type < o.type;
+    }
+};
+
+enum : uint8_t { kBoth = 0, kLeftOnly = 1, kRightOnly = 2 };
+
+// Bounds of the part of triangle v inside `box` (Sutherland-Hodgman in double), rounded outwards
+// and never larger than the box or the triangle's own bounds. Empty when the triangle misses it.
+AABB clipped_bounds(const vec3 v[3], const AABB& box) {
+    AABB tb(v[0], v[0]);
+    tb.expand(v[1]);
+    tb.expand(v[2]);
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) inside &= tb.min[i] >= box.min[i] && tb.max[i] <= box.max[i];
+    if (inside) return tb;
+
+    dvec3 poly[2][9];
+    int n = 3;
+    for (int i = 0; i < 3; ++i) poly[0][i] = dvec3(v[i]);
+    int cur = 0;
+    for (int a = 0; a < 3 && n > 0; ++a) {
+        for (int side = 0; side < 2 && n > 0; ++side) {
+            const double c = side == 0 ? box.min[a] : box.max[a];
+            const double sign = side == 0 ? 1.0 : -1.0;  // inside: sign * (p[a] - c) >= 0
+            const dvec3* in = poly[cur];
+            dvec3* out = poly[cur ^ 1];
+            int m = 0;
+            for (int i = 0; i < n; ++i) {
+                const dvec3& p = in[i];
+                const dvec3& q = in[(i + 1) % n];
+                const bool pin = sign * (p[a] - c) >= 0.0, qin = sign * (q[a] - c) >= 0.0;
+                if (pin) out[m++] = p;
+                if (pin != qin) {
+                    dvec3 x = p + (q - p) * ((c - p[a]) / (q[a] - p[a]));
+                    x[a] = c;
+                    out[m++] = x;
+                }
+            }
+            n = m;
+            cur ^= 1;
+        }
+    }
+    if (n == 0) return AABB();
+    dvec3 lo(poly[cur][0]), hi(poly[cur][0]);
+    for (int i = 1; i < n; ++i) {
+        lo = glm::min(lo, poly[cur][i]);
+        hi = glm::max(hi, poly[cur][i]);
+    }
+    AABB out;
+    for (int i = 0; i < 3; ++i) {
+        out.min[i] = std::max({box.min[i], tb.min[i], next_float_down(float(lo[i]))});
+        out.max[i] = std::min({box.max[i], tb.max[i], next_float_up(float(hi[i]))});
+        if (out.min[i] > out.max[i]) {  // a sliver at the rounding limit: keep it, flat
+            float x = std::clamp(float(lo[i]), box.min[i], box.max[i]);
+            out.min[i] = out.max[i] = x;
+        }
+    }
+    return out;
+}
+
+void add_events(std::vector<Event>& out, uint32_t tri, const AABB& b) {
+    for (uint8_t d = 0; d < 3; ++d) {
+        if (b.min[d] == b.max[d]) {
+            out.push_back({b.min[d], tri, d, kPlanar});
+        } else {
+            out.push_back({b.min[d], tri, d, kStart});
+            out.push_back({b.max[d], tri, d, kEnd});
+        }
+    }
+}
+
+struct BuildNode {
+    std::unique_ptr<BuildNode> child[2];
+    std::vector<uint32_t> prims;  // leaves only; builder-local triangle indices
+    float split = 0.f;
+    int axis = -1;  // -1: leaf
+};
+
+class Builder {
+public:
+    Builder(const Mesh& mesh, const std::vector<uint32_t>& tris, const KdBuildOptions& opt, size_t n)
+        : mesh_(mesh), tris_(tris), opt_(opt) {
+        int md = opt.max_depth >= 0 ? opt.max_depth : int(8 + 1.3 * std::log2(double(std::max<size_t>(n, 1))));
+        max_depth_ = std::min(md, KdTree::kMaxDepth);
+        flags_.resize(size_t(omp_get_max_threads()));
+        for (auto& f : flags_) f.resize(tris.size());
+    }
+
+    // `stalls`: consecutive ancestors whose split left one child with all of their triangles.
+    std::unique_ptr<BuildNode> build(std::vector<Event>& events, size_t n, const AABB& box, int depth, int stalls) {
+        auto node = std::make_unique<BuildNode>();
+        const float leaf_cost = opt_.intersection_cost * float(n);
+        const float sa = box.surface_area();
+        float best_cost = kInfinity;
+        float best_pos = 0.f;
+        int best_dim = -1;
+        bool planar_left = false;
+        if (n > 0 && depth < max_depth_ && sa > 0.f)
+            sweep(events, n, box, sa, stalls < opt_.max_stalls, best_cost, best_pos, best_dim, planar_left);
+
+        if (best_dim < 0 || !(best_cost < leaf_cost)) {
+            make_leaf(*node, events, n);
+            return node;
+        }
+
+        // Classify (Wald-Havran section 5.1): a triangle is on one side when its extent along the
+        // split axis ends at or before the plane (left) or starts at or after it (right).
+        std::vector<uint8_t>& flag = flags_[size_t(omp_get_thread_num())];
+        for (const Event& e : events) flag[e.tri] = kBoth;
+        for (const Event& e : events) {
+            if (e.dim != best_dim) continue;
+            if (e.type == kEnd && e.pos <= best_pos) flag[e.tri] = kLeftOnly;
+            else if (e.type == kStart && e.pos >= best_pos) flag[e.tri] = kRightOnly;
+            else if (e.type == kPlanar) {
+                if (e.pos < best_pos || (e.pos == best_pos && planar_left)) flag[e.tri] = kLeftOnly;
+                else if (e.pos > best_pos || (e.pos == best_pos && !planar_left)) flag[e.tri] = kRightOnly;
+            }
+        }
+
+        AABB lbox = box, rbox = box;
+        lbox.max[best_dim] = best_pos;
+        rbox.min[best_dim] = best_pos;
+
+        // Split the sorted list in one pass; the lists stay sorted. Straddling triangles are clipped
+        // to each child and their new events sorted and merged in.
+        std::vector<Event> el, er, nl_ev, nr_ev;
+        el.reserve(events.size() / 2 + 16);
+        er.reserve(events.size() / 2 + 16);
+        std::vector<uint32_t> straddle;
+        size_t nl = 0, nr = 0;
+        for (const Event& e : events) {
+            const uint8_t f = flag[e.tri];
+            if (f == kLeftOnly) el.push_back(e);
+            else if (f == kRightOnly) er.push_back(e);
+            if (e.dim == 0 && e.type != kEnd) {  // once per triangle
+                if (f == kLeftOnly) ++nl;
+                else if (f == kRightOnly) ++nr;
+                else straddle.push_back(e.tri);
+            }
+        }
+        for (uint32_t t : straddle) {
+            vec3 v[3];
+            mesh_.vertices(tris_[t], v[0], v[1], v[2]);
+            AABB lb = clipped_bounds(v, lbox), rb = clipped_bounds(v, rbox);
+            if (!lb.empty()) { add_events(nl_ev, t, lb); ++nl; }
+            if (!rb.empty()) { add_events(nr_ev, t, rb); ++nr; }
+        }
+        std::vector<Event>().swap(events);  // the parent's list is no longer needed
+        merge_into(el, nl_ev);
+        merge_into(er, nr_ev);
+
+        node->axis = best_dim;
+        node->split = best_pos;
+        // With perfect splits the SAH never stops zooming in on a shared vertex: every box around
+        // it holds all the triangles of its fan, and there is always empty space to cut off. A
+        // split that leaves a child with all of the node's triangles counts as a stall; after
+        // max_stalls of them in a row only splits that reduce both sides are considered.
+        const int lstall = nl >= n ? stalls + 1 : 0, rstall = nr >= n ? stalls + 1 : 0;
+        const bool spawn = parallel_ && el.size() + er.size() > 20000 && depth < 12;
+        if (spawn) {
+#pragma omp task default(shared)
+            node->child[0] = build(el, nl, lbox, depth + 1, lstall);
+            node->child[1] = build(er, nr, rbox, depth + 1, rstall);
+#pragma omp taskwait
+        } else {
+            node->child[0] = build(el, nl, lbox, depth + 1, lstall);
+            node->child[1] = build(er, nr, rbox, depth + 1, rstall);
+        }
+        return node;
+    }
+
+    bool parallel_ = false;
+
+private:
+    float cost(float pl, float pr, size_t nl, size_t nr) const {
+        float c = opt_.traversal_cost + opt_.intersection_cost * (pl * float(nl) + pr * float(nr));
+        if (nl == 0 || nr == 0) c *= 1.f - opt_.empty_bonus;
+        return c;
+    }
+
+    // Sweeps the sorted events once, keeping per-axis counts left / planar / right of the plane.
+    // Without `allow_stall`, only splits that leave each child fewer triangles than the node count.
+    void sweep(const std::vector<Event>& ev, size_t n, const AABB& box, float sa, bool allow_stall, float& best_cost,
+               float& best_pos, int& best_dim, bool& planar_left) const {
+        size_t nl[3] = {0, 0, 0}, nr[3] = {n, n, n};
+        const float inv_sa = 1.f / sa;
+        const vec3 ext = box.extent();
+        size_t i = 0;
+        const size_t m = ev.size();
+        while (i < m) {
+            const float pos = ev[i].pos;
+            const int d = ev[i].dim;
+            size_t pe = 0, pp = 0, ps = 0;
+            while (i < m && ev[i].dim == d && ev[i].pos == pos && ev[i].type == kEnd) { ++pe; ++i; }
+            while (i < m && ev[i].dim == d && ev[i].pos == pos && ev[i].type == kPlanar) { ++pp; ++i; }
+            while (i < m && ev[i].dim == d && ev[i].pos == pos && ev[i].type == kStart) { ++ps; ++i; }
+            nr[d] -= pp + pe;
+            // Planes on the node's faces are skipped: they would give a child equal to the node.
+            if (pos > box.min[d] && pos < box.max[d]) {
+                const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+                const float cross = ext[d1] * ext[d2];
+                const float span = ext[d1] + ext[d2];
+                const float pl = 2.f * (cross + (pos - box.min[d]) * span) * inv_sa;
+                const float pr = 2.f * (cross + (box.max[d] - pos) * span) * inv_sa;
+                const float cl = cost(pl, pr, nl[d] + pp, nr[d]);
+                const float cr = cost(pl, pr, nl[d], nr[d] + pp);
+                const bool ok_l = allow_stall || (nl[d] + pp < n && nr[d] < n);
+                const bool ok_r = allow_stall || (nl[d] < n && nr[d] + pp < n);
+                if (cl < best_cost && ok_l) { best_cost = cl; best_pos = pos; best_dim = d; planar_left = true; }
+                if (cr < best_cost && ok_r) { best_cost = cr; best_pos = pos; best_dim = d; planar_left = false; }
+            }
+            nl[d] += ps + pp;
+        }
+    }
+
+    static void merge_into(std::vector<Event>& list, std::vector<Event>& extra) {
+        if (extra.empty()) return;
+        std::sort(extra.begin(), extra.end());
+        const size_t mid = list.size();
+        list.insert(list.end(), extra.begin(), extra.end());
+        std::inplace_merge(list.begin(), list.begin() + std::ptrdiff_t(mid), list.end());
+    }
+
+    static void make_leaf(BuildNode& node, const std::vector<Event>& events, size_t n) {
+        node.prims.reserve(n);
+        for (const Event& e : events)
+            if (e.dim == 0 && e.type != kEnd) node.prims.push_back(e.tri);
+    }
+
+    const Mesh& mesh_;
+    const std::vector<uint32_t>& tris_;
+    KdBuildOptions opt_;
+    int max_depth_ = 0;
+    std::vector<std::vector<uint8_t>> flags_;  // per thread: side of each triangle at the current node
+};
+
+// Sign-aware widening of a ray parameter by about 2^-16 of its size: room for the rounding of
+// split-plane distances and of triangle hit distances (both a few ulps) so that the traversal
+// never culls a node that brute force would find a hit in.
+constexpr float kSlack = 1.f / 65536.f;
+inline float widen_down(float t) { return t - kSlack * std::fabs(t); }
+inline float widen_up(float t) { return t + kSlack * std::fabs(t); }
+
+}  // namespace
+
+// ---- KdTree ---------------------------------------------------------------------------------
+
+void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AABB* clip, const KdBuildOptions& opt) {
+    nodes_.clear();
+    tris_.clear();
+    bounds_ = AABB();
+    stats_ = {};
+
+    std::vector<uint32_t> all;
+    if (!tris) {
+        all.resize(mesh.triangles.size());
+        for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+        tris = &all;
+    }
+    const std::vector<uint32_t>& list = *tris;
+    if (list.empty()) return;
+
+    std::vector<Event> events;
+    events.reserve(list.size() * 6);
+    size_t n = 0;
+    for (uint32_t i = 0; i < list.size(); ++i) {
+        vec3 v[3];
+        mesh.vertices(list[i], v[0], v[1], v[2]);
+        AABB b;
+        if (clip) {
+            b = clipped_bounds(v, *clip);
+            if (b.empty()) continue;
+        } else {
+            b = AABB(v[0], v[0]);
+            b.expand(v[1]);
+            b.expand(v[2]);
+        }
+        add_events(events, i, b);
+        bounds_.expand(b);
+        ++n;
+    }
+    if (n == 0) return;
+    std::sort(events.begin(), events.end());
+
+    Builder builder(mesh, list, opt, n);
+    std::unique_ptr<BuildNode> root;
+    if (opt.parallel && !omp_in_parallel() && omp_get_max_threads() > 1) {
+        builder.parallel_ = true;
+#pragma omp parallel
+#pragma omp single
+        root = builder.build(events, n, bounds_, 0, 0);
+    } else {
+        root = builder.build(events, n, bounds_, 0, 0);
+    }
+
+    // Flatten depth first: the first child follows its parent, so interior nodes store only the
+    // index of the second.
+    struct Flatten {
+        KdTree& t;
+        const Mesh& mesh;
+        const std::vector<uint32_t>& list;
+        void operator()(const BuildNode& bn, int depth) {
+            const size_t idx = t.nodes_.size();
+            t.nodes_.emplace_back();
+            t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
+            if (bn.axis < 0) {
+                Node& nd = t.nodes_[idx];
+                nd.first = uint32_t(t.tris_.size());
+                nd.bits = (uint32_t(bn.prims.size()) << 2) | 3u;
+                for (uint32_t p : bn.prims) {
+                    LeafTri lt;
+                    lt.prim = list[p];
+                    mesh.vertices(lt.prim, lt.p0, lt.p1, lt.p2);
+                    t.tris_.push_back(lt);
+                }
+                ++t.stats_.leaves;
+                if (bn.prims.empty()) ++t.stats_.empty_leaves;
+                return;
+            }
+            (*this)(*bn.child[0], depth + 1);
+            const uint32_t above = uint32_t(t.nodes_.size());
+            (*this)(*bn.child[1], depth + 1);
+            Node& nd = t.nodes_[idx];
+            nd.split = bn.split;
+            nd.bits = (above << 2) | uint32_t(bn.axis);
+        }
+    };
+    Flatten{*this, mesh, list}(*root, 0);
+    nodes_.shrink_to_fit();
+    tris_.shrink_to_fit();
+    stats_.nodes = nodes_.size();
+    stats_.references = tris_.size();
+}
+
+size_t KdTree::memory_bytes() const {
+    return nodes_.capacity() * sizeof(Node) + tris_.capacity() * sizeof(LeafTri);
+}
+
+namespace {
+
+// Per-ray constants in plain arrays: glm's operator[] is a switch, too slow for the inner loops.
+struct RayData {
+    float o[3], d[3], inv_d[3];
+    int kx, ky, kz;
+    float sx, sy, sz;
+    explicit RayData(const Ray& ray) {
+        const RayShear sh(ray.d);
+        for (int i = 0; i < 3; ++i) {
+            o[i] = ray.o[i];
+            d[i] = ray.d[i];
+            inv_d[i] = 1.f / ray.d[i];
+        }
+        kx = sh.kx, ky = sh.ky, kz = sh.kz;
+        sx = sh.sx, sy = sh.sy, sz = sh.sz;
+    }
+};
+
+// intersect_triangle() (geometry/triangle.h) operation for operation, so that t, b1 and b2 are
+// bit-identical to it (the build has no FMA contraction), with array indexing instead of glm's.
+inline bool hit_triangle(const RayData& r, float tmin, float tmax, const float* v, TriangleHit& hit) {
+    const float* p0 = v;
+    const float* p1 = v + 3;
+    const float* p2 = v + 6;
+    const int kx = r.kx, ky = r.ky, kz = r.kz;
+    const float a_z = p0[kz] - r.o[kz], b_z = p1[kz] - r.o[kz], c_z = p2[kz] - r.o[kz];
+    const float ax = (p0[kx] - r.o[kx]) + r.sx * a_z, ay = (p0[ky] - r.o[ky]) + r.sy * a_z;
+    const float bx = (p1[kx] - r.o[kx]) + r.sx * b_z, by = (p1[ky] - r.o[ky]) + r.sy * b_z;
+    const float cx = (p2[kx] - r.o[kx]) + r.sx * c_z, cy = (p2[ky] - r.o[ky]) + r.sy * c_z;
+    float e0 = bx * cy - by * cx;
+    float e1 = cx * ay - cy * ax;
+    float e2 = ax * by - ay * bx;
+    if (e0 == 0.f || e1 == 0.f || e2 == 0.f) {
+        e0 = float(double(bx) * double(cy) - double(by) * double(cx));
+        e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
+        e2 = float(double(ax) * double(by) - double(ay) * double(bx));
+    }
+    if ((e0 < 0.f || e1 < 0.f || e2 < 0.f) && (e0 > 0.f || e1 > 0.f || e2 > 0.f)) return false;
+    const float det = e0 + e1 + e2;
+    if (det == 0.f) return false;
+    const float az = r.sz * a_z, bz = r.sz * b_z, cz = r.sz * c_z;
+    const float t_scaled = e0 * az + e1 * bz + e2 * cz;
+    if (det < 0.f && (t_scaled >= tmin * det || t_scaled <= tmax * det)) return false;
+    if (det > 0.f && (t_scaled <= tmin * det || t_scaled >= tmax * det)) return false;
+    const float inv_det = 1.f / det;
+    const float t = t_scaled * inv_det;
+    if (!(t > tmin && t < tmax)) return false;
+    hit.t = t;
+    hit.b1 = e1 * inv_det;
+    hit.b2 = e2 * inv_det;
+    return true;
+}
+
+}  // namespace
+
+template <bool Shadow>
+bool KdTree::trace(Ray& ray, Hit* hit) const {
+    if (nodes_.empty()) return false;
+    const RayData r(ray);
+    float t0, t1;
+    if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
+
+    struct Todo {
+        const Node* node;
+        float t0, t1;
+    };
+    Todo stack[kMaxDepth + 4];
+    int sp = 0;
+    const Node* nodes = nodes_.data();
+    const Node* node = nodes;
+    const float tmin = ray.tmin;
+    float tmax = ray.tmax;
+    bool found = false;
+    for (;;) {
+        if (!node->leaf()) {
+            const int a = node->axis();
+            const float split = node->split;
+            const float oa = r.o[a];
+            const float tp = (split - oa) * r.inv_d[a];
+            // The sign of split - o is exact, so the child holding the origin is found without
+            // rounding; a ray starting on the plane goes first to the side it moves into.
+            const bool below_first = oa < split || (oa == split && r.d[a] <= 0.f);
+            const Node* below = node + 1;
+            const Node* above = nodes + node->above();
+            const Node* first = below_first ? below : above;
+            const Node* second = below_first ? above : below;
+            // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
+            // for a ray lying in the plane, which then visits both children over the whole interval
+            // (std::max / std::min return their first argument for a NaN second).
+            if (tp > widen_up(t1) || tp <= 0.f) {
+                node = first;
+            } else if (tp < widen_down(t0)) {
+                node = second;
+            } else {
+                stack[sp++] = {second, std::max(t0, widen_down(tp)), t1};
+                node = first;
+                t1 = std::min(t1, widen_up(tp));
+            }
+            continue;
+        }
+
+        const uint32_t count = node->count();
+        const LeafTri* lt = tris_.data() + node->first;
+        for (uint32_t i = 0; i < count; ++i, ++lt) {
+            TriangleHit th;
+            if (hit_triangle(r, tmin, tmax, &lt->p0.x, th)) {
+                if constexpr (Shadow) {
+                    return true;
+                } else {
+                    tmax = th.t;
+                    ray.tmax = th.t;
+                    hit->t = th.t;
+                    hit->b1 = th.b1;
+                    hit->b2 = th.b2;
+                    hit->prim = lt->prim;
+                    found = true;
+                }
+            }
+        }
+        // Next node in ray order; stop once the closest hit lies before it (with slack, so that
+        // a hit within rounding of the boundary still meets the triangles beyond it).
+        if (sp == 0) return found;
+        const Todo& td = stack[--sp];
+        if (!Shadow && found && tmax < widen_down(td.t0)) return true;
+        node = td.node;
+        t0 = td.t0;
+        t1 = td.t1;
+    }
+}
+
+bool KdTree::intersect(Ray& ray, Hit& hit) const { return trace<false>(ray, &hit); }
+
+bool KdTree::occluded(const Ray& ray) const {
+    Ray r = ray;
+    return trace<true>(r, nullptr);
+}
+
+template bool KdTree::trace<false>(Ray&, Hit*) const;
+template bool KdTree::trace<true>(Ray&, Hit*) const;
+
+}  // namespace candela

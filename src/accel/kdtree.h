@@ -1,0 +1,107 @@
+#pragma once
+// SAH k-d tree over the triangles of a Mesh.
+//
+// Build: Wald and Havran 2006, "On building fast kd-trees for ray tracing, and on doing that in
+// O(N log N)". Split candidates are the bounds of each triangle clipped to the node ("perfect
+// splits"); the events are sorted once at the root and each node sweeps its own sorted list, then
+// splits it into the children's lists without re-sorting (only the few straddling triangles are
+// clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
+//
+// Traversal: 8-byte nodes, a fixed-size stack, template <bool Shadow> for the any-hit variant.
+// Leaves point into an array of triangle copies (three vertices + the triangle index), so a leaf
+// test reads one contiguous block instead of chasing index -> vertex pointers. Every triangle test
+// is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the same t,
+// bit for bit, as the brute-force oracle.
+#include <cstdint>
+#include <vector>
+#include "accel/accel.h"
+#include "core/aabb.h"
+
+namespace candela {
+
+struct KdBuildOptions {
+    // Surface area heuristic: cost = traversal + intersection * (P_left N_left + P_right N_right),
+    // times (1 - empty_bonus) when one side is empty. Units: one triangle test = intersection.
+    float traversal_cost = 1.f;
+    float intersection_cost = 0.8f;
+    float empty_bonus = 0.1f;
+    int max_stalls = 3;        // consecutive splits that keep all triangles on one side (see .cpp)
+    int max_depth = -1;        // -1: 8 + 1.3 log2(N), capped by the traversal stack
+    bool parallel = true;      // OpenMP tasks (ignored when already inside a parallel region)
+};
+
+struct KdTreeStats {
+    size_t nodes = 0, leaves = 0, empty_leaves = 0, references = 0;
+    int max_depth = 0;
+};
+
+// The tree itself, without the Accel vtable: the hybrid grid holds one per cell.
+class KdTree {
+public:
+    static constexpr int kMaxDepth = 60;  // the traversal stack holds kMaxDepth + 4 entries
+
+    KdTree() = default;
+    // Builds over triangles `tris` of `mesh` (all of them when tris is null). When `clip` is given,
+    // every triangle is clipped to it first: the tree then covers only the part of space inside
+    // `clip` (used by the grid, whose cells each hold a tree).
+    void build(const Mesh& mesh, const std::vector<uint32_t>* tris = nullptr, const AABB* clip = nullptr,
+               const KdBuildOptions& opt = {});
+
+    // Closest hit in (ray.tmin, ray.tmax); shrinks ray.tmax. Same contract as Accel::intersect.
+    bool intersect(Ray& ray, Hit& hit) const;
+    bool occluded(const Ray& ray) const;
+
+    const AABB& bounds() const { return bounds_; }
+    bool empty() const { return nodes_.empty(); }
+    size_t memory_bytes() const;
+    const KdTreeStats& stats() const { return stats_; }
+
+    // Compact node: an interior node keeps the split position and the index of its second
+    // ("above") child (the first follows it directly); a leaf keeps its first slot in tris_ and
+    // its triangle count.
+    struct Node {
+        union {
+            float split;
+            uint32_t first;
+        };
+        uint32_t bits;  // low 2 bits: axis 0-2, or 3 for a leaf; high 30: above child / count
+        bool leaf() const { return (bits & 3u) == 3u; }
+        int axis() const { return int(bits & 3u); }
+        uint32_t above() const { return bits >> 2; }
+        uint32_t count() const { return bits >> 2; }
+    };
+    static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
+
+    // One leaf reference: a copy of the triangle's vertices, so the leaf test needs no indirection.
+    struct LeafTri {
+        vec3 p0, p1, p2;
+        uint32_t prim;
+    };
+
+private:
+    template <bool Shadow>
+    bool trace(Ray& ray, Hit* hit) const;
+
+    std::vector<Node> nodes_;
+    std::vector<LeafTri> tris_;
+    AABB bounds_;
+    KdTreeStats stats_;
+};
+
+class KdTreeAccel final : public Accel {
+public:
+    explicit KdTreeAccel(const Mesh& mesh, const KdBuildOptions& opt = {}) : mesh_(&mesh) {
+        tree_.build(mesh, nullptr, nullptr, opt);
+    }
+    bool intersect(Ray& ray, Hit& hit) const override { return tree_.intersect(ray, hit); }
+    bool occluded(const Ray& ray) const override { return tree_.occluded(ray); }
+    std::string name() const override { return "kdtree"; }
+    size_t memory_bytes() const override { return tree_.memory_bytes(); }
+    const KdTree& tree() const { return tree_; }
+
+private:
+    const Mesh* mesh_;
+    KdTree tree_;
+};
+
+}  // namespace candela
