@@ -4,8 +4,9 @@
 
 namespace candela {
 
-Scene prepare_scene(const std::string& path, const SceneOverrides& ov) {
-    Scene scene = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
+namespace {
+
+void apply_overrides_and_finalize(Scene& scene, const SceneOverrides& ov) {
     RenderSettings& st = scene.settings;
     if (ov.width) st.width = *ov.width;
     if (ov.height) st.height = *ov.height;
@@ -16,6 +17,19 @@ Scene prepare_scene(const std::string& path, const SceneOverrides& ov) {
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
     scene.finalize(ov.accel);
+}
+
+}  // namespace
+
+Scene prepare_scene(const std::string& path, const SceneOverrides& ov) {
+    Scene scene = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
+    apply_overrides_and_finalize(scene, ov);
+    return scene;
+}
+
+std::shared_ptr<Scene> prepare_scene_shared(const std::string& path, const SceneOverrides& ov) {
+    auto scene = std::make_shared<Scene>(path.empty() ? make_cornell_box() : load_scene(path, ov.defines));
+    apply_overrides_and_finalize(*scene, ov);
     return scene;
 }
 

@@ -1,0 +1,156 @@
+#pragma once
+// A render session: one worker thread that runs passes of the Renderer until told otherwise, for an
+// interactive front end that must never wait for a pass.
+//
+// Threads and ownership. The worker owns the Scene's mutable state (camera, settings, materials,
+// emitters, lights) and the films; the front end never touches them. It keeps its own copy of that
+// state (SceneParams), edits the copy and hands it over with update(): the worker is cancelled
+// (Renderer::render_pass checks the flag per tile, so it stops within one tile per thread), applies
+// the copy, clears the films and starts again. The front end only ever takes a mutex for a swap of
+// pointers or a few scalars. The geometry (mesh, shapes, accelerator) is immutable after
+// Scene::finalize and may be read by the front end at any time (scene()), for picking.
+//
+// What the worker renders after a restart: one preview pass at 1/preview_scale of the resolution,
+// shown at once, then full-resolution passes. While the front end says the user is interacting
+// (set_interactive, e.g. during a camera drag) it keeps rendering previews only, so each camera
+// change costs 1/16 of a pass. Full passes accumulate; each completed pass is resolved to RGB and
+// published. A cancelled pass is discarded (its film is cleared by the restart), so the film never
+// holds a pixel with the same sample index twice.
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+#include "film/film.h"
+#include "scene/scene.h"
+
+namespace candela {
+
+// Everything the image depends on that can change without rebuilding the geometry.
+struct SceneParams {
+    Camera camera;
+    RenderSettings settings;
+    std::vector<Material> materials;
+    std::vector<AreaEmitter> emitters;
+
+    static SceneParams from(const Scene& s) { return {s.camera, s.settings, s.materials, s.emitters}; }
+};
+
+struct SessionOptions {
+    int threads = 0;        // render threads; <= 0: all cores
+    int spp_per_pass = 1;   // samples per pixel in each full-resolution pass
+    int preview_scale = 4;  // preview passes render (width / scale) x (height / scale) pixels
+    int max_passes = 0;     // idle after this many full passes (0: never), e.g. for screenshots
+};
+
+// A resolved image, as published to the front end.
+struct SessionImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb;   // linear RGB, row-major from the top-left
+    bool preview = false;     // reduced resolution: scale it up to the full image's size
+    uint64_t generation = 0;  // which restart it belongs to (see SessionStats::generation)
+    uint64_t sequence = 0;    // increases with every publish, across restarts
+    int passes = 0;           // full passes in it (preview: preview passes)
+};
+
+struct SessionStats {
+    uint64_t generation = 0;  // restarts so far (0: the first render)
+    int passes = 0;           // completed full-resolution passes since the restart
+    double spp = 0;           // samples per pixel in the full film
+    double elapsed = 0;       // seconds of rendering since the restart (paused time excluded)
+    double msamples_per_s = 0, mrays_per_s = 0;  // over the full passes of this generation
+    uint64_t nonfinite = 0;   // NaN/Inf samples dropped by the film (Film::nonfinite_count)
+    bool paused = false, idle = false, preview = false;
+    // Convergence: after every full pass k >= 2, the mean over pixels of |L_k - L_{k-1}| / (L_{k-1} + eps)
+    // on luminance, with the time it was measured (seconds since the restart).
+    std::vector<float> change, change_time;
+};
+
+class RenderSession {
+public:
+    // Starts the worker at once. The scene must be finalized.
+    RenderSession(std::shared_ptr<Scene> scene, const SessionOptions& opt);
+    // Cancels the pass in flight and joins the worker (at most one tile per thread of waiting).
+    ~RenderSession();
+    RenderSession(const RenderSession&) = delete;
+    RenderSession& operator=(const RenderSession&) = delete;
+
+    // The scene's geometry, read-only, for picking. Its camera, settings, materials and emitters
+    // belong to the worker: read the SceneParams copy instead. Valid until replace_scene.
+    std::shared_ptr<const Scene> scene() const;
+
+    // Every edit that changes the image goes through here: cancels the pass in flight and restarts
+    // with `p`. Returns at once; the new generation number is returned.
+    uint64_t update(const SceneParams& p);
+    // A new scene (e.g. a dropped file), with its own parameters. Restarts.
+    uint64_t replace_scene(std::shared_ptr<Scene> scene);
+    // Clears the film and starts again with the same parameters.
+    uint64_t reset();
+
+    // While true, only preview passes are rendered. Does not restart: turning it off lets the
+    // worker begin full passes on the (already cleared) film.
+    void set_interactive(bool on);
+    // Paused: no more full passes after the one in flight (which completes). Edits while paused
+    // still restart and render one preview, so that the image shows them.
+    void set_paused(bool on);
+    bool paused() const { return paused_.load(); }
+    // Thread count for the next pass; does not change the image (it does not depend on it).
+    void set_threads(int n) { threads_.store(n); }
+    int threads() const;
+
+    // Moves the newest published image into `img` when it is newer than img.sequence (the old
+    // buffer is recycled by the worker). Returns false, leaving img alone, when there is none.
+    bool take_image(SessionImage& img);
+    // The newest full-resolution image, copied (e.g. for saving). Empty before the first full pass.
+    SessionImage latest_full_image() const;
+    SessionStats stats() const;
+    // Called on the worker thread after each publish (e.g. glfwPostEmptyEvent to wake the UI loop).
+    // Set it before rendering matters; it must be cheap and thread-safe.
+    void set_on_publish(std::function<void()> f);
+
+    // Blocks until an image of generation >= gen with at least `passes` full passes (0: any
+    // image, preview included) is published, or the timeout expires. For tests and tools only.
+    bool wait_for(uint64_t gen, int passes, double timeout_seconds);
+
+private:
+    struct Pending;
+    void worker();
+    // Resolves the film and publishes it. update_stats runs under the same lock, with the
+    // convergence measure of a full pass against the previous one (-1 when there is none).
+    void publish(const Film& film, bool preview, uint64_t gen, int passes,
+                 const std::function<void(SessionStats&, double)>& update_stats);
+    uint64_t request_restart_locked();
+
+    SessionOptions opt_;
+    std::thread thread_;
+    std::atomic<bool> cancel_{false};
+    std::atomic<bool> paused_{false};
+    std::atomic<int> threads_{0};
+
+    mutable std::mutex mu_;  // guards everything below
+    std::condition_variable cv_;
+    std::condition_variable published_cv_;
+    bool quit_ = false;
+    bool interactive_ = false;
+    std::unique_ptr<Pending> pending_;  // edits not yet seen by the worker
+    uint64_t generation_ = 0;           // latest requested generation
+    std::shared_ptr<Scene> scene_;      // the worker's scene (geometry shared with the front end)
+    SessionImage front_;                // newest published image (swapped out by take_image)
+    SessionImage full_;                 // newest full-resolution image
+    uint64_t sequence_ = 0;
+    SessionStats stats_;
+    std::function<void()> on_publish_;
+    uint64_t published_generation_ = 0;
+
+    // The worker's own buffers (no lock): the next image to publish, the previous full pass.
+    SessionImage back_;
+    std::vector<float> last_full_;
+};
+
+// Mean relative change of luminance between two RGB images of the same size, over pixels where
+// either is non-zero: mean(|a - b| / (b + eps)). The convergence measure the session plots.
+double mean_relative_change(const std::vector<float>& a, const std::vector<float>& b, float eps = 1e-3f);
+
+}  // namespace candela
