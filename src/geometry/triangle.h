@@ -44,6 +44,11 @@ inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3
         e2 = float(double(ax) * double(by) - double(ay) * double(bx));
     }
     if ((e0 < 0.f || e1 < 0.f || e2 < 0.f) && (e0 > 0.f || e1 > 0.f || e2 > 0.f)) return false;
+    // A zero-area triangle (collinear vertices) can pass the edge test: the shear rounds its edge
+    // functions to tiny values of one sign. Reject it as pbrt-v4 does (checked here, after the
+    // cheap edge test, so that it costs nothing for the many triangles that miss).
+    vec3 n = glm::cross(p1 - p0, p2 - p0);
+    if (n.x == 0.f && n.y == 0.f && n.z == 0.f) return false;
     float det = e0 + e1 + e2;
     if (det == 0.f) return false;
 
