@@ -33,6 +33,7 @@ struct Scene {
     std::vector<AreaEmitter> emitters;
     Camera camera;
     RenderSettings settings;
+    std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
 
     std::unique_ptr<Accel> accel;
     LightSet lights;
