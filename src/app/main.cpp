@@ -39,11 +39,11 @@ int main(int argc, char** argv) {
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
     app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
-    std::string screenshot;
-    int screenshot_after = 0;
-    auto* shot = app.add_option("--screenshot-after", screenshot_after, "Viewer: render N passes, then save the window")
-        ->check(CLI::PositiveNumber);
-    app.add_option("--screenshot", screenshot, "Viewer: PNG file for --screenshot-after");
+    // --screenshot-after N FILE: one option with two values (a pair: CLI11 checks both types).
+    std::pair<int, std::string> shot_args{0, ""};
+    auto* shot = app.add_option("--screenshot-after", shot_args,
+                                "Viewer: render N passes, save the window (panel included) to the PNG FILE, exit")
+                     ->type_name("N FILE");
 
     try {
         app.parse(argc, argv);
@@ -76,8 +76,9 @@ int main(int argc, char** argv) {
             vo.threads = opt.threads;
             vo.display = opt.display;
             vo.spp_per_frame = opt.spp_per_frame;
-            vo.screenshot_after = screenshot_after;
-            vo.screenshot = screenshot;
+            vo.screenshot_after = shot_args.first;
+            vo.screenshot = shot_args.second;
+            if (*shot && vo.screenshot_after < 1) throw Error("--screenshot-after expects N >= 1 passes");
             return run_viewer(vo);
         }
 #else

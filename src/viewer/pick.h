@@ -1,0 +1,40 @@
+#pragma once
+// What is under a pixel: one camera ray traced through the scene's accelerator. Used by the
+// viewer's click-to-inspect; no window system here, so the tests can call it.
+#include <string>
+#include "scene/scene.h"
+
+namespace candela {
+
+struct PickResult {
+    bool hit = false;
+    vec3 position{0.f};
+    vec3 normal{0.f};    // shading normal
+    float distance = 0.f;
+    uint32_t shape = ~0u, material = ~0u, triangle = ~0u;
+    int32_t emitter = -1;
+};
+
+// `camera` must have had set_film_size called for the film the pixel belongs to; `film_pos` is in
+// film pixels (x right, y down; the centre of pixel (i, j) is (i + 0.5, j + 0.5)). Reads only the
+// scene's geometry (mesh, shapes, accelerator), which is immutable while a session renders.
+inline PickResult pick(const Scene& scene, const Camera& camera, vec2 film_pos) {
+    PickResult r;
+    if (!scene.accel) return r;
+    Ray ray = camera.generate_ray(film_pos);
+    Hit hit;
+    if (!scene.accel->intersect(ray, hit)) return r;
+    SurfaceInteraction si = scene.interaction(hit);
+    const Shape& shape = scene.shapes[si.shape];
+    r.hit = true;
+    r.position = si.p;
+    r.normal = si.ns;
+    r.distance = glm::length(si.p - camera.origin());
+    r.shape = si.shape;
+    r.material = shape.material;
+    r.triangle = hit.prim;
+    r.emitter = shape.emitter;
+    return r;
+}
+
+}  // namespace candela

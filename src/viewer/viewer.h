@@ -1,0 +1,39 @@
+#pragma once
+// The interactive viewer: a GLFW window that shows the film converging (through the shared display
+// program, the one tonemap), a Dear ImGui panel to edit the scene, and camera controls. Rendering
+// happens in a RenderSession; the window's thread never waits for a pass.
+#include <string>
+#include <vector>
+#include "display/display.h"
+#include "render/launch.h"
+
+namespace candela {
+
+// Responsiveness measurement (bench/viewer): the viewer moves the camera by itself on a schedule
+// and records how the window keeps up. Not used by the program's command line.
+struct ViewerBenchmark {
+    double duration = 10;       // seconds of measurement, after the first full-resolution pass
+    double move_every = 0.25;   // seconds between scripted camera changes (a small orbit step)
+    int moves_per_burst = 1;    // consecutive frames that each change the camera (a "drag")
+    // Results.
+    std::vector<double> frame_ms;   // UI work per frame: events, panel, upload, draw, swap
+    std::vector<double> update_ms;  // camera change -> end of the first frame showing its image
+    int frames = 0;
+};
+
+struct ViewerOptions {
+    std::string scene;           // empty: the built-in Cornell box
+    SceneOverrides overrides;
+    int threads = 0;             // render threads; 0: all cores
+    DisplaySettings display;     // initial exposure
+    int spp_per_frame = 1;       // samples per pixel in each full-resolution pass
+    int screenshot_after = 0;    // > 0: render this many passes, save the window, exit
+    std::string screenshot;      // PNG file for screenshot_after
+    ViewerBenchmark* benchmark = nullptr;
+};
+
+// Opens the window and runs until it is closed (or the screenshot is written). Returns the process
+// exit code. Throws Error when the scene cannot be loaded or no window can be opened.
+int run_viewer(const ViewerOptions& opt);
+
+}  // namespace candela
