@@ -60,9 +60,10 @@ struct ExrErr {
 };
 struct ExrHeaderGuard {
     EXRHeader h;
-    bool parsed = false;
     ExrHeaderGuard() { InitEXRHeader(&h); }
-    ~ExrHeaderGuard() { if (parsed) FreeEXRHeader(&h); }
+    // Freed even when parsing failed: tinyexr fills the header from what it read before the
+    // error, and a zeroed header frees as a no-op.
+    ~ExrHeaderGuard() { FreeEXRHeader(&h); }
 };
 struct ExrImageGuard {
     EXRImage img;
@@ -126,6 +127,38 @@ int find_channel(const EXRHeader& h, const char* name) {
     return -1;
 }
 
+// Every chunk named by the offset table of a scanline file must lie inside the file.
+void check_exr_chunks(const std::string& path, const EXRHeader& h, const std::vector<unsigned char>& data) {
+    int lines = 1;  // scanlines per chunk, by compression (OpenEXR file layout)
+    switch (h.compression_type) {
+        case TINYEXR_COMPRESSIONTYPE_NONE: case TINYEXR_COMPRESSIONTYPE_RLE: case TINYEXR_COMPRESSIONTYPE_ZIPS:
+            lines = 1; break;
+        case TINYEXR_COMPRESSIONTYPE_ZIP: case 5 /* PXR24 */: lines = 16; break;
+        case TINYEXR_COMPRESSIONTYPE_PIZ: case 6 /* B44 */: case 7 /* B44A */: lines = 32; break;
+        default: return;  // other codecs are left to tinyexr
+    }
+    const long long height = (long long)h.data_window.max_y - h.data_window.min_y + 1;
+    if (height <= 0) throw Error(path, 0, "EXR data window is empty");
+    const long long chunks = (height + lines - 1) / lines;
+    auto le = [&](size_t at, int n) {  // little-endian unsigned integer of n bytes
+        uint64_t v = 0;
+        for (int k = 0; k < n; ++k) v |= uint64_t(data[at + size_t(k)]) << (8 * k);
+        return v;
+    };
+    const size_t table = size_t(h.header_len) + 8;  // after magic, version and header
+    if (table > data.size() || uint64_t(chunks) > (data.size() - table) / 8)
+        throw Error(path, 0, "truncated EXR (offset table cut short)");
+    for (long long c = 0; c < chunks; ++c) {
+        const uint64_t offset = le(table + size_t(c) * 8, 8);
+        // A chunk is: int32 y, int32 byte count, bytes.
+        if (offset > data.size() || data.size() - offset < 8)
+            throw Error(path, 0, "truncated or corrupt EXR (chunk " + std::to_string(c) + " outside the file)");
+        const uint64_t bytes = le(size_t(offset) + 4, 4);
+        if (bytes > data.size() - offset - 8)
+            throw Error(path, 0, "truncated EXR (chunk " + std::to_string(c) + " cut short)");
+    }
+}
+
 Image read_exr(const std::string& path, const std::vector<unsigned char>& data) {
     EXRVersion version;
     int rc = ParseEXRVersionFromMemory(&version, data.data(), data.size());
@@ -137,12 +170,14 @@ Image read_exr(const std::string& path, const std::vector<unsigned char>& data) 
     ExrErr err;
     rc = ParseEXRHeaderFromMemory(&header.h, &version, data.data(), data.size(), &err.msg);
     if (rc != TINYEXR_SUCCESS) throw Error(path, 0, "bad EXR header: " + err.text(rc));
-    header.parsed = true;
     // Half channels are widened to float on load so that one code path reads every channel.
     for (int c = 0; c < header.h.num_channels; ++c)
         if (header.h.pixel_types[c] == TINYEXR_PIXELTYPE_HALF)
             header.h.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
 
+    // On a decoding error tinyexr 1.0.1 leaks its channel buffers (and freeing the image would
+    // double-free), so truncated scanline files, the common bad file, are caught here first.
+    if (!header.h.tiled) check_exr_chunks(path, header.h, data);
     ExrImageGuard image;
     rc = LoadEXRImageFromMemory(&image.img, &header.h, data.data(), data.size(), &err.msg);
     if (rc != TINYEXR_SUCCESS) throw Error(path, 0, "cannot decode EXR pixels: " + err.text(rc));
