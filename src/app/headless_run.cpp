@@ -36,8 +36,11 @@ int run_headless(const HeadlessOptions& opt) {
     if (ext != ".png" && ext != ".exr" && ext != ".pfm")
         throw Error(opt.out, 0, "unknown output format '" + ext + "' (expected .png, .exr or .pfm)");
 
-    Scene scene = prepare_scene(opt.scene, opt.overrides);
+    std::shared_ptr<Scene> scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    const Scene& scene = *scene_ptr;
     const RenderSettings& st = scene.settings;
+    if (!opt.quiet)
+        for (const std::string& w : scene.warnings) std::fprintf(stderr, "candela: warning: %s\n", w.c_str());
     int frames = opt.frames > 0 ? opt.frames : std::max(1, st.spp / std::max(1, opt.spp_per_frame));
     Film film(st.width, st.height);
     int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();

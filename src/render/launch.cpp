@@ -21,13 +21,7 @@ void apply_overrides_and_finalize(Scene& scene, const SceneOverrides& ov) {
 
 }  // namespace
 
-Scene prepare_scene(const std::string& path, const SceneOverrides& ov) {
-    Scene scene = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
-    apply_overrides_and_finalize(scene, ov);
-    return scene;
-}
-
-std::shared_ptr<Scene> prepare_scene_shared(const std::string& path, const SceneOverrides& ov) {
+std::shared_ptr<Scene> prepare_scene(const std::string& path, const SceneOverrides& ov) {
     auto scene = std::make_shared<Scene>(path.empty() ? make_cornell_box() : load_scene(path, ov.defines));
     apply_overrides_and_finalize(*scene, ov);
     return scene;

@@ -18,12 +18,13 @@ struct SceneOverrides {
 };
 
 // Loads `path` (or the built-in Cornell box when empty), applies the overrides and finalises the
-// scene (accelerator, lights, camera). Throws Error with file:line on bad input.
-Scene prepare_scene(const std::string& path, const SceneOverrides& ov);
-// The same, on the heap, for code that shares the scene between threads (the viewer). A finalized
-// Scene must not be moved: its accelerator and lights point into its mesh. This one is moved
-// before finalize() and never after.
-std::shared_ptr<Scene> prepare_scene_shared(const std::string& path, const SceneOverrides& ov);
+// scene (accelerator, lights, camera). Throws Error with file:line on bad input. The scene lives on
+// the heap because a finalized Scene must never move: its accelerator and lights point into its
+// mesh. It is shared, since the viewer hands it to render threads.
+std::shared_ptr<Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
+inline std::shared_ptr<Scene> prepare_scene_shared(const std::string& path, const SceneOverrides& ov) {
+    return prepare_scene(path, ov);  // the viewer's older name; same function
+}
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
 const char* sampling_mode_name(SamplingMode m);

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# candela against Mitsuba 3 on the same scene file, in one sitting: samples/s of candela and of
+# Mitsuba's scalar_rgb and llvm_ad_rgb variants at the same resolution, spp, depth and thread count,
+# and whether the images agree within Monte Carlo noise (../shared/tools/imgcmp.py).
+#
+# Usage: bash bench/mitsuba/compare.sh [SCENE.xml] [--res N] [--spp N] [--max-depth M] [--threads T]
+#   SCENE defaults to scenes/cornell-box/scene.xml; --max-depth is MITSUBA's max_depth (path
+#   segments; candela gets M - 1 through the XML); default 8, i.e. 7 scattering events.
+# Output goes to out/bench-mitsuba/. Needs ../shared/tools (setup-reference.sh installs Mitsuba).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+scene=scenes/cornell-box/scene.xml
+res=256 spp=256 depth=8 threads=2
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --res) res=$2; shift 2 ;;
+    --spp) spp=$2; shift 2 ;;
+    --max-depth) depth=$2; shift 2 ;;
+    --threads) threads=$2; shift 2 ;;
+    -*) echo "compare.sh: unknown option $1" >&2; exit 2 ;;
+    *) scene=$1; shift ;;
+  esac
+done
+shared=../shared/tools
+eval "$(bash $shared/setup-reference.sh --no-apt | grep '^PY=')"
+bash scripts/build.sh >/dev/null
+out=out/bench-mitsuba
+mkdir -p "$out"
+defs=(-D "res=$res" -D "width=$res" -D "height=$res" -D "spp=$spp" -D "max_depth=$depth")
+
+echo "scene=$scene res=${res}x${res} spp=$spp mitsuba_max_depth=$depth threads=$threads machine=$(lscpu | sed -n 's/^Model name: *//p')"
+c_line=$(build/bin/candela "$scene" "${defs[@]}" --frames "$spp" --threads "$threads" --out "$out/candela.exr" 2>&1 | tail -n 1)
+c_sps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Msamples\/s.*/\1/p')
+c_rps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Mrays\/s.*/\1/p')
+echo "candela:            $c_sps Msamples/s ($c_rps Mrays/s)"
+for variant in scalar_rgb llvm_ad_rgb; do
+  log=$("$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant $variant --spp "$spp" --threads "$threads" \
+        --warmup --out "$out/mitsuba_$variant.exr" 2>&1)
+  sps=$(echo "$log" | grep -o '[0-9.e+]* samples/s' | tail -n 1 | awk '{printf "%.3f", $1 / 1e6}')
+  echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(awk -v a="$c_sps" -v b="$sps" 'BEGIN{printf "%.2f", a / b}')"
+done
+echo "--- imgcmp candela vs mitsuba llvm_ad_rgb (same spp) ---"
+"$PY" $shared/imgcmp.py "$out/candela.exr" "$out/mitsuba_llvm_ad_rgb.exr" --spp "$spp" --ref-spp "$spp" || true
