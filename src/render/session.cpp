@@ -1,6 +1,10 @@
 #include "render/session.h"
 #include <omp.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include "render/renderer.h"
 
@@ -208,6 +212,14 @@ void RenderSession::publish(const Film& film, bool preview, uint64_t gen, int pa
 }
 
 void RenderSession::worker() {
+    if (opt_.nice > 0) {
+        // Linux schedules threads, not processes: this lowers the worker's priority, and the
+        // OpenMP threads it creates for its passes inherit it. Raising nice never needs privileges.
+        const id_t tid = id_t(syscall(SYS_gettid));
+        errno = 0;
+        int cur = getpriority(PRIO_PROCESS, tid);
+        if (errno == 0) setpriority(PRIO_PROCESS, tid, std::min(19, cur + opt_.nice));
+    }
     Film full, preview;
     std::shared_ptr<Scene> scene;
     uint64_t gen = 0;
@@ -215,6 +227,7 @@ void RenderSession::worker() {
     bool need_preview = false;
     int full_w = 0, full_h = 0, prev_w = 0, prev_h = 0;
     double render_time = 0, full_time = 0;
+    double sec_per_sample = 0;  // measured, smoothed over passes: sizes the previews
     uint64_t full_samples = 0, full_rays = 0;
     auto last_tick = Clock::now();
 
@@ -262,8 +275,16 @@ void RenderSession::worker() {
             }
             full_w = scene->settings.width;
             full_h = scene->settings.height;
-            prev_w = std::max(1, full_w / opt_.preview_scale);
-            prev_h = std::max(1, full_h / opt_.preview_scale);
+            // The preview's scale: at least preview_scale, more when the last passes say that a
+            // preview at that scale would take longer than the budget (a slow scene or machine).
+            int scale = opt_.preview_scale;
+            if (opt_.preview_budget > 0 && sec_per_sample > 0) {
+                double samples = opt_.preview_budget / sec_per_sample;
+                double need = std::ceil(std::sqrt(double(full_w) * double(full_h) / std::max(samples, 1.0)));
+                scale = int(std::clamp(need, double(opt_.preview_scale), double(std::max(opt_.preview_scale, 16))));
+            }
+            prev_w = std::max(1, full_w / scale);
+            prev_h = std::max(1, full_h / scale);
             full.resize(full_w, full_h);
             preview.resize(prev_w, prev_h);
             passes = preview_passes = 0;
@@ -294,6 +315,10 @@ void RenderSession::worker() {
         if (!ps.completed) continue;  // cancelled: a restart is pending and will clear the film
 
         render_time += dt;
+        if (ps.samples > 0) {
+            double s = dt / double(ps.samples);
+            sec_per_sample = sec_per_sample > 0 ? 0.7 * sec_per_sample + 0.3 * s : s;
+        }
         if (is_preview) {
             ++preview_passes;
             need_preview = false;

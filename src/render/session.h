@@ -13,7 +13,7 @@
 // What the worker renders after a restart: one preview pass at 1/preview_scale of the resolution,
 // shown at once, then full-resolution passes. While the front end says the user is interacting
 // (set_interactive, e.g. during a camera drag) it keeps rendering previews only, so each camera
-// change costs 1/16 of a pass. Full passes accumulate; each completed pass is resolved to RGB and
+// change costs 1/16 of a pass (less when preview_budget asks for it). Full passes accumulate; each completed pass is resolved to RGB and
 // published. A cancelled pass is discarded (its film is cleared by the restart), so the film never
 // holds a pixel with the same sample index twice.
 #include <atomic>
@@ -42,7 +42,11 @@ struct SessionOptions {
     int threads = 0;        // render threads; <= 0: all cores
     int spp_per_pass = 1;   // samples per pixel in each full-resolution pass
     int preview_scale = 4;  // preview passes render (width / scale) x (height / scale) pixels
+    double preview_budget = 0;  // > 0: seconds a preview pass should take; the scale grows (up
+                                // to 16) when the measured speed says preview_scale is too slow
     int max_passes = 0;     // idle after this many full passes (0: never), e.g. for screenshots
+    int nice = 0;           // > 0: lower the render threads' priority by this much (Linux nice),
+                            // so that a window's thread is scheduled first on a loaded machine
 };
 
 // A resolved image, as published to the front end.

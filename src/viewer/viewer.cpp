@@ -147,6 +147,8 @@ Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
     so.threads = opt.threads;
     so.spp_per_pass = std::max(1, opt.spp_per_frame);
     so.max_passes = opt.screenshot_after;
+    so.nice = 5;                  // the window's thread first: it needs little, but on time
+    so.preview_budget = 0.025;    // previews that keep up with the mouse on a slow machine
     session_ = std::make_unique<RenderSession>(scene, so);
     // Wakes the event loop when an image is ready: the window sleeps in glfwWaitEvents otherwise.
     session_->set_on_publish([] { glfwPostEmptyEvent(); });
