@@ -1,6 +1,8 @@
 #include "viewer/panel.h"
 #include <imgui.h>
 #include <algorithm>
+#include <type_traits>
+#include <utility>
 
 namespace candela {
 
@@ -17,25 +19,78 @@ bool drag_positive(const char* label, vec3& v, float speed) {
     return changed;
 }
 
-// One editor per BSDF type. Overload resolution picks the exact one; the template catches types
-// that have none yet, so adding a BSDF to the variant never breaks the viewer's build.
-bool edit_bsdf(DiffuseBsdf& b) { return reflectance("albedo", b.albedo); }
-
+// Member detection: the BSDFs are plain structs of parameters with conventional names, so one
+// generic editor shows the widgets for exactly the parameters a type has.
+#define CANDELA_HAS_MEMBER(name)                                                                    \
+    template <class T, class M, class = void>                                                       \
+    struct has_##name : std::false_type {};                                                         \
+    template <class T, class M>                                                                     \
+    struct has_##name<T, M, std::void_t<decltype(std::declval<T&>().name)>>                         \
+        : std::is_same<decltype(std::declval<T&>().name), M> {};
+CANDELA_HAS_MEMBER(albedo)
+CANDELA_HAS_MEMBER(diffuse_reflectance)
+CANDELA_HAS_MEMBER(specular_reflectance)
+CANDELA_HAS_MEMBER(specular_transmittance)
+CANDELA_HAS_MEMBER(eta)
+CANDELA_HAS_MEMBER(k)
+CANDELA_HAS_MEMBER(int_ior)
+CANDELA_HAS_MEMBER(ext_ior)
+CANDELA_HAS_MEMBER(alpha)
+CANDELA_HAS_MEMBER(nonlinear)
+#undef CANDELA_HAS_MEMBER
+template <class T, class = void>
+struct has_prepare : std::false_type {};
 template <class T>
-bool edit_bsdf(T&) {
-    ImGui::TextDisabled("(no editable parameters)");
-    return false;
+struct has_prepare<T, std::void_t<decltype(std::declval<T&>().prepare())>> : std::true_type {};
+
+bool ior(const char* label, float& v) {
+    bool changed = ImGui::DragFloat(label, &v, 0.005f, 1.f, 4.f, "%.4f");
+    if (changed) v = std::clamp(v, 1.f, 4.f);
+    return changed;
 }
 
-struct TypeName {
-    const char* operator()(const DiffuseBsdf&) const { return "diffuse"; }
-    template <class T>
-    const char* operator()(const T&) const { return "bsdf"; }
-};
+// One editor per BSDF: the generic one below, unless a type needs its own overload (overload
+// resolution prefers a non-template function), e.g. edit_bsdf(DiffuseBsdf&).
+template <class T>
+bool edit_bsdf(T& b) {
+    bool changed = false, any = false;
+    if constexpr (has_albedo<T, vec3>::value) any = true, changed |= reflectance("albedo", b.albedo);
+    if constexpr (has_diffuse_reflectance<T, vec3>::value)
+        any = true, changed |= reflectance("diffuse", b.diffuse_reflectance);
+    if constexpr (has_specular_reflectance<T, vec3>::value)
+        any = true, changed |= reflectance("specular tint", b.specular_reflectance);
+    if constexpr (has_specular_transmittance<T, vec3>::value)
+        any = true, changed |= reflectance("transmission tint", b.specular_transmittance);
+    if constexpr (has_eta<T, vec3>::value) any = true, changed |= drag_positive("eta", b.eta, 0.01f);
+    if constexpr (has_k<T, vec3>::value) any = true, changed |= drag_positive("k", b.k, 0.01f);
+    if constexpr (has_int_ior<T, float>::value) any = true, changed |= ior("interior IOR", b.int_ior);
+    if constexpr (has_ext_ior<T, float>::value) any = true, changed |= ior("exterior IOR", b.ext_ior);
+    if constexpr (has_alpha<T, float>::value)
+        any = true, changed |= ImGui::SliderFloat("roughness", &b.alpha, 0.f, 1.f, "alpha %.3f");
+    if constexpr (has_nonlinear<T, bool>::value)
+        any = true, changed |= ImGui::Checkbox("nonlinear", &b.nonlinear);
+    if (!any) ImGui::TextDisabled("(no editable parameters)");
+    // Derived data (e.g. the plastic coat's tables) must follow the parameters.
+    if constexpr (has_prepare<T>::value)
+        if (changed) b.prepare();
+    return changed;
+}
+
+// Model names, recognised by their parameters as well (the variant may grow).
+template <class T>
+const char* model_name(const T&) {
+    if constexpr (has_albedo<T, vec3>::value) return "diffuse";
+    else if constexpr (has_diffuse_reflectance<T, vec3>::value) return "plastic";
+    else if constexpr (has_specular_transmittance<T, vec3>::value) return "dielectric";
+    else if constexpr (has_k<T, vec3>::value) return "conductor";
+    else return "bsdf";
+}
 
 }  // namespace
 
-const char* bsdf_type_name(const Bsdf& b) { return std::visit(TypeName{}, b); }
+const char* bsdf_type_name(const Bsdf& b) {
+    return std::visit([](const auto& x) { return model_name(x); }, b);
+}
 
 bool edit_material(Material& m) {
     bool changed = std::visit([](auto& b) { return edit_bsdf(b); }, m.bsdf);

@@ -9,8 +9,12 @@ namespace candela {
 // The BSDF's model name ("diffuse", ...) as shown in the panel.
 const char* bsdf_type_name(const Bsdf& b);
 
-// Widgets for the parameters of the material's BSDF (dispatched by std::visit: one overload per
-// BSDF type, so a new BSDF needs one new function) and its two-sided flag.
+// Widgets for the parameters of the material's BSDF and its two-sided flag. std::visit dispatches
+// to edit_bsdf(T&): a generic template that shows exactly the parameters type T has (found by their
+// names: albedo, diffuse_reflectance, specular_reflectance, eta, k, int_ior, alpha, ...), so a new
+// BSDF with conventional parameter names needs no viewer code; one with unusual parameters gets a
+// non-template overload, which overload resolution prefers. Calls T::prepare() after an edit when
+// the type has one (derived tables).
 bool edit_material(Material& m);
 
 // Radiance of an area light (RGB, may exceed 1).

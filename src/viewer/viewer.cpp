@@ -516,6 +516,7 @@ void Viewer::panel() {
             ImGui::PushID(int(i));
             const bool selected = int(i) == selected_material_;
             if (selected && reveal_selected_) ImGui::SetNextItemOpen(true);
+            else if (i == 0) ImGui::SetNextItemOpen(true, ImGuiCond_Once);  // show what editing looks like
             ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | (selected ? ImGuiTreeNodeFlags_Selected : 0);
             bool open = ImGui::TreeNodeEx("##m", flags, "%s  (%s)", m.name.empty() ? "(unnamed)" : m.name.c_str(),
                                           bsdf_type_name(m.bsdf));
