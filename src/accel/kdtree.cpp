@@ -478,14 +478,20 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
                 }
             }
         }
-        // Next node in ray order; stop once the closest hit lies before it (with slack, so that
-        // a hit within rounding of the boundary still meets the triangles beyond it).
-        if (sp == 0) return found;
-        const Todo& td = stack[--sp];
-        if (!Shadow && found && tmax < widen_down(td.t0)) return true;
-        node = td.node;
-        t0 = td.t0;
-        t1 = td.t1;
+        // Next node in ray order, skipping those that start beyond the closest hit (with slack, so
+        // that a hit within rounding of a boundary still meets the triangles beyond it). Entries
+        // are skipped, not the walk ended: a ray lying in a split plane pushes a node whose
+        // interval starts before those pushed after it.
+        for (;;) {
+            if (sp == 0) return found;
+            const Todo& td = stack[--sp];
+            if (Shadow || !(tmax < widen_down(td.t0))) {
+                node = td.node;
+                t0 = td.t0;
+                t1 = td.t1;
+                break;
+            }
+        }
     }
 }
 
