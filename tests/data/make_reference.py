@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Makes a committed reference for the image tests: the mean of K independent Mitsuba 3 renders
+of a scene and the variance of that mean per pixel and channel (from the spread of the K batch
+means), both written as float32 EXR.
+
+Usage (PY from ../shared/tools/setup-reference.sh):
+  $PY tests/data/make_reference.py scenes/cornell-box/scene.xml --res 64 --batches 16 --spp 4096 \
+      --out tests/data/cornell64
+writes tests/data/cornell64_mean.exr and tests/data/cornell64_var.exr.
+"""
+import argparse
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+TOOLS = os.path.normpath(os.path.join(HERE, "..", "..", "..", "shared", "tools"))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("scene")
+    ap.add_argument("--res", type=int, default=64)
+    ap.add_argument("--batches", type=int, default=16)
+    ap.add_argument("--spp", type=int, default=4096)
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("-D", dest="defines", action="append", default=[])
+    a = ap.parse_args()
+
+    import mitsuba as mi
+    mi.set_variant("scalar_rgb")
+    imgs = []
+    for k in range(a.batches):
+        path = "%s_batch%d.exr" % (a.out, k)
+        cmd = [sys.executable, os.path.join(TOOLS, "mitsuba_render.py"), a.scene, "--variant", a.variant,
+               "--spp", str(a.spp), "--seed", str(k + 1), "--out", path, "-D", "res=%d" % a.res]
+        for d in a.defines:
+            cmd += ["-D", d]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        imgs.append(np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3])
+        os.remove(path)
+        if os.path.exists(path[:-4] + ".json"):  # mitsuba_render.py writes its timing beside
+            os.remove(path[:-4] + ".json")
+    stack = np.stack(imgs)
+    mean = stack.mean(axis=0)
+    var_of_mean = stack.var(axis=0, ddof=1) / a.batches
+    mi.Bitmap(mean.astype(np.float32)).write(a.out + "_mean.exr")
+    mi.Bitmap(var_of_mean.astype(np.float32)).write(a.out + "_var.exr")
+    print("wrote %s_mean.exr and %s_var.exr: %d batches x %d spp, mean RGB %s"
+          % (a.out, a.out, a.batches, a.spp, mean.reshape(-1, 3).mean(axis=0)))
+
+
+if __name__ == "__main__":
+    main()

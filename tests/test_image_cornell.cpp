@@ -1,0 +1,103 @@
+// Image test: candela's built-in Cornell box against a committed Mitsuba 3 reference of the same
+// scene (scenes/cornell-box/scene.xml), within Monte Carlo noise.
+//
+// The reference (tests/data/cornell64_mean.exr, cornell64_var.exr) is the mean of 16 independent
+// Mitsuba 3.9.1 llvm_ad_rgb renders of 4096 spp each at 64 x 64, unbounded depth, box filter, and
+// the per-pixel variance of that mean from the spread of the 16 batches; tests/data/make_reference.py
+// made it:
+//   $PY tests/data/make_reference.py scenes/cornell-box/scene.xml --res 64 --batches 16 --spp 4096 \
+//       --out tests/data/cornell64
+// candela renders 8 batches of 64 spp with different seeds; its variance comes from the batch
+// spread too. Two checks: a block z-test (8 x 8 blocks, Sidak-corrected over blocks and channels)
+// for local errors, and a whole-image z-test per channel for small global biases that no single
+// block can resolve. A control with a 3% darker white albedo must fail, so the test has the power to
+// see errors of that size.
+#include <gtest/gtest.h>
+#include <cstdio>
+#include <memory>
+#include "film/image_io.h"
+#include "render/renderer.h"
+#include "scene/cornell.h"
+#include "support/stats.h"
+
+using namespace candela;
+using namespace candela::stats;
+
+namespace {
+
+constexpr int kRes = 64;
+constexpr double kAlpha = 0.01;
+
+ImageEstimate load_reference() {
+    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/cornell64_mean.exr");
+    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/cornell64_var.exr");
+    ImageEstimate e;
+    e.width = mean.width;
+    e.height = mean.height;
+    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
+        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
+        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
+    }
+    return e;
+}
+
+ImageEstimate render_candela(float white_scale) {
+    Scene scene = make_cornell_box();
+    std::get<DiffuseBsdf>(scene.materials[0].bsdf).albedo *= white_scale;
+    scene.settings.width = kRes;
+    scene.settings.height = kRes;
+    scene.finalize();
+    const int batches = 8, spp = 64;
+    std::vector<std::unique_ptr<Film>> films;
+    std::vector<const Film*> ptrs;
+    for (int b = 0; b < batches; ++b) {
+        films.push_back(std::make_unique<Film>(kRes, kRes));
+        scene.settings.seed = uint64_t(b + 1);
+        Renderer::render_pass(scene, *films.back(), 0, spp, 0);
+        ptrs.push_back(films.back().get());
+    }
+    return ImageEstimate::from_batches(ptrs);
+}
+
+// Whole-image mean per channel: z of the difference, using both images' variances.
+double whole_image_p(const ImageEstimate& a, const ImageEstimate& b, dvec3* rel_diff) {
+    dvec3 ma(0.0), mb(0.0), v(0.0);
+    const double n = double(a.mean.size());
+    for (size_t i = 0; i < a.mean.size(); ++i) {
+        ma += a.mean[i];
+        mb += b.mean[i];
+        v += a.var_of_mean[i] + b.var_of_mean[i];
+    }
+    ma /= n;
+    mb /= n;
+    v /= n * n;
+    double p_min = 1;
+    for (int c = 0; c < 3; ++c) p_min = std::min(p_min, normal_two_sided_p((ma[c] - mb[c]) / std::sqrt(v[c])));
+    if (rel_diff) *rel_diff = (ma - mb) / mb;
+    return sidak_adjust(p_min, 3);
+}
+
+}  // namespace
+
+TEST(ImageCornell, BuiltinBoxMatchesMitsubaReference) {
+    ImageEstimate ref = load_reference();
+    ASSERT_EQ(ref.width, kRes);
+    ImageEstimate test = render_candela(1.f);
+    BlockTestResult r = block_z_test(test, ref, 8, kAlpha);
+    dvec3 rel;
+    double p_global = whole_image_p(test, ref, &rel);
+    std::printf("  blocks: %s\n  whole image: p = %.3g, relative difference (%.4f, %.4f, %.4f)\n",
+                r.describe().c_str(), p_global, rel.x, rel.y, rel.z);
+    EXPECT_TRUE(r.passed(kAlpha)) << r.describe();
+    EXPECT_GE(p_global, kAlpha);
+}
+
+TEST(ImageCornell, DetectsThreePercentAlbedoError) {
+    ImageEstimate ref = load_reference();
+    ImageEstimate test = render_candela(0.97f);
+    BlockTestResult r = block_z_test(test, ref, 8, kAlpha);
+    double p_global = whole_image_p(test, ref, nullptr);
+    std::printf("  3%% darker white: blocks %s, whole image p = %.3g\n", r.describe().c_str(), p_global);
+    EXPECT_TRUE(!r.passed(kAlpha) || p_global < kAlpha);
+    EXPECT_LT(p_global, kAlpha);
+}
