@@ -360,57 +360,17 @@ size_t KdTree::memory_bytes() const {
 
 namespace {
 
-// Per-ray constants in plain arrays: glm's operator[] is a switch, too slow for the inner loops.
+// Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
     float o[3], d[3], inv_d[3];
-    int kx, ky, kz;
-    float sx, sy, sz;
     explicit RayData(const Ray& ray) {
-        const RayShear sh(ray.d);
         for (int i = 0; i < 3; ++i) {
             o[i] = ray.o[i];
             d[i] = ray.d[i];
             inv_d[i] = 1.f / ray.d[i];
         }
-        kx = sh.kx, ky = sh.ky, kz = sh.kz;
-        sx = sh.sx, sy = sh.sy, sz = sh.sz;
     }
 };
-
-// intersect_triangle() (geometry/triangle.h) operation for operation, so that t, b1 and b2 are
-// bit-identical to it (the build has no FMA contraction), with array indexing instead of glm's.
-inline bool hit_triangle(const RayData& r, float tmin, float tmax, const float* v, TriangleHit& hit) {
-    const float* p0 = v;
-    const float* p1 = v + 3;
-    const float* p2 = v + 6;
-    const int kx = r.kx, ky = r.ky, kz = r.kz;
-    const float a_z = p0[kz] - r.o[kz], b_z = p1[kz] - r.o[kz], c_z = p2[kz] - r.o[kz];
-    const float ax = (p0[kx] - r.o[kx]) + r.sx * a_z, ay = (p0[ky] - r.o[ky]) + r.sy * a_z;
-    const float bx = (p1[kx] - r.o[kx]) + r.sx * b_z, by = (p1[ky] - r.o[ky]) + r.sy * b_z;
-    const float cx = (p2[kx] - r.o[kx]) + r.sx * c_z, cy = (p2[ky] - r.o[ky]) + r.sy * c_z;
-    float e0 = bx * cy - by * cx;
-    float e1 = cx * ay - cy * ax;
-    float e2 = ax * by - ay * bx;
-    if (e0 == 0.f || e1 == 0.f || e2 == 0.f) {
-        e0 = float(double(bx) * double(cy) - double(by) * double(cx));
-        e1 = float(double(cx) * double(ay) - double(cy) * double(ax));
-        e2 = float(double(ax) * double(by) - double(ay) * double(bx));
-    }
-    if ((e0 < 0.f || e1 < 0.f || e2 < 0.f) && (e0 > 0.f || e1 > 0.f || e2 > 0.f)) return false;
-    const float det = e0 + e1 + e2;
-    if (det == 0.f) return false;
-    const float az = r.sz * a_z, bz = r.sz * b_z, cz = r.sz * c_z;
-    const float t_scaled = e0 * az + e1 * bz + e2 * cz;
-    if (det < 0.f && (t_scaled >= tmin * det || t_scaled <= tmax * det)) return false;
-    if (det > 0.f && (t_scaled <= tmin * det || t_scaled >= tmax * det)) return false;
-    const float inv_det = 1.f / det;
-    const float t = t_scaled * inv_det;
-    if (!(t > tmin && t < tmax)) return false;
-    hit.t = t;
-    hit.b1 = e1 * inv_det;
-    hit.b2 = e2 * inv_det;
-    return true;
-}
 
 }  // namespace
 
@@ -418,6 +378,7 @@ template <bool Shadow>
 bool KdTree::trace(Ray& ray, Hit* hit) const {
     if (nodes_.empty()) return false;
     const RayData r(ray);
+    const RayShear sh(ray.d);
     float t0, t1;
     if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
 
@@ -429,7 +390,6 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     int sp = 0;
     const Node* nodes = nodes_.data();
     const Node* node = nodes;
-    const float tmin = ray.tmin;
     float tmax = ray.tmax;
     bool found = false;
     for (;;) {
@@ -464,7 +424,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         const LeafTri* lt = tris_.data() + node->first;
         for (uint32_t i = 0; i < count; ++i, ++lt) {
             TriangleHit th;
-            if (hit_triangle(r, tmin, tmax, &lt->p0.x, th)) {
+            // The shared watertight test itself, so that hits are bit-identical to brute force.
+            if (intersect_triangle(ray, sh, lt->p0, lt->p1, lt->p2, th)) {
                 if constexpr (Shadow) {
                     return true;
                 } else {
