@@ -11,12 +11,23 @@
 // TransportMode says which quantity flows along the path: Radiance (camera paths) or Importance
 // (light paths, for bidirectional methods), for the non-symmetric scaling of refraction.
 #include <optional>
+#include <string>
+#include <type_traits>
 #include <variant>
+#include "bsdf/conductor.h"
+#include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
+#include "bsdf/plastic.h"
 
 namespace candela {
 
-using Bsdf = std::variant<DiffuseBsdf>;
+// Each alternative is a plain struct of parameters (the viewer edits them in place):
+//   DiffuseBsdf     Lambertian                                   (Mitsuba `diffuse`)
+//   ConductorBsdf   mirror (alpha 0) or GGX metal                (`conductor`, `roughconductor`)
+//   PlasticBsdf     dielectric coat over a diffuse base          (`plastic`, `roughplastic`)
+//   DielectricBsdf  glass, smooth (alpha 0) or GGX rough         (`dielectric`, `roughdielectric`)
+// docs/materials.md describes each model and its tests.
+using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf>;
 
 inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     return std::visit([&](const auto& x) { return x.eval(wo, wi, mode); }, b);
@@ -31,6 +42,14 @@ inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u
 // True when the BSDF has a non-delta component, so that light sampling can contribute.
 inline bool has_smooth_component(const Bsdf& b) {
     return std::visit([](const auto& x) { return x.has_smooth_component(); }, b);
+}
+
+// Derives what a BSDF precomputes from its parameters (the plastic coat's tables). Call it after
+// creating or editing a BSDF; it is cheap when nothing changed.
+inline void prepare(Bsdf& b) {
+    std::visit([](auto& x) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, PlasticBsdf>) x.prepare();
+    }, b);
 }
 
 // A material as scenes name it: a BSDF plus whether both sides of the surface scatter.

@@ -10,6 +10,9 @@ struct BsdfSample {
     vec3 wi{0.f};      // sampled direction, local frame
     float pdf = 0.f;   // solid-angle density, or the lobe's discrete probability for delta lobes
     bool delta = false;
+    // Relative IOR crossed: n(wi side) / n(wo side); 1 for reflection. Radiance is scaled by
+    // 1 / eta^2 through a refraction, which Russian roulette undoes so as not to kill paths in glass.
+    float eta = 1.f;
     vec3 weight() const { return pdf > 0.f ? f / pdf : vec3(0.f); }
 };
 

@@ -19,6 +19,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     bool after_delta = true;     // camera rays and delta bounces: emission always counts fully
     float prev_pdf = 0.f;        // solid-angle pdf of the BSDF sample that led here
     vec3 prev_p(0.f);
+    float eta_scale = 1.f;       // product of eta^2 over refractions: undoes their radiance scaling
 
     for (int depth = 0;; ++depth) {
         Hit hit;
@@ -82,6 +83,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         if (!bs || !(bs->pdf > 0.f)) break;
         beta *= bs->weight();
         if (is_black(beta)) break;
+        eta_scale *= sqr(bs->eta);
         after_delta = bs->delta;
         prev_pdf = bs->pdf;
         prev_p = si.p;
@@ -89,7 +91,9 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         ray = spawn_ray(si, wi_world);
 
         if (depth + 1 >= st.rr_depth) {
-            float q = std::min(max_component(beta), 0.95f);
+            // Survival by the throughput without the 1/eta^2 of refractions, which only reflects the
+            // change of solid angle: a path inside glass is not less important (pbrt-v4 etaScale).
+            float q = std::min(max_component(beta) * eta_scale, 0.95f);
             if (sampler.next_1d() >= q) break;
             beta /= q;
         }

@@ -1,0 +1,71 @@
+#pragma once
+#include <optional>
+#include "bsdf/common.h"
+#include "bsdf/fresnel.h"
+#include "bsdf/microfacet.h"
+
+namespace candela {
+
+// A metal: specular reflection weighted by the conductor Fresnel term, smooth or rough.
+//   alpha == 0   ideal mirror, a delta lobe (Mitsuba 3 `conductor`): sample() returns the mirror
+//                direction with pdf 1 and f = specular_reflectance * F(cos theta_o); eval = pdf = 0.
+//   alpha > 0    GGX microfacet reflection (Walter et al. 2007; Mitsuba 3 `roughconductor`):
+//                f(wo, wi) cos theta_i = R F(wo.h) D(h) G1(wo, h) G1(wi, h) / (4 cos theta_o),
+//                h = normalize(wo + wi); sampled from the normals visible from wo, so
+//                pdf = D_wo(h) / (4 wo.h) and the weight is R F G1(wi, h).
+// One-sided: zero unless wo and wi are both above the surface (use the material's two_sided flag).
+// Reflection only, so eval is symmetric and the transport mode does not matter.
+// With the default (eta, k) = (0, 1), F = 1: a perfect mirror, tinted by specular_reflectance.
+struct ConductorBsdf {
+    vec3 eta{0.f};                   // complex IOR of the metal relative to the outside medium
+    vec3 k{1.f};
+    vec3 specular_reflectance{1.f};  // tint R (not physical, but handy)
+    float alpha = 0.f;               // GGX roughness; 0 = ideal mirror
+
+    bool is_delta() const { return !(alpha > 0.f); }
+
+    vec3 eval(vec3 wo, vec3 wi, TransportMode) const {
+        if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return vec3(0.f);
+        return eval_pdf(wo, wi).first;
+    }
+    float pdf(vec3 wo, vec3 wi, TransportMode) const {
+        if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return 0.f;
+        return eval_pdf(wo, wi).second;
+    }
+    std::optional<BsdfSample> sample(vec3 wo, float, vec2 u, TransportMode) const {
+        if (wo.z <= 0.f) return std::nullopt;
+        BsdfSample s;
+        if (is_delta()) {
+            s.wi = reflect_z(wo);
+            s.pdf = 1.f;
+            s.delta = true;
+            s.f = specular_reflectance * fresnel_conductor(wo.z, eta, k);
+            return s;
+        }
+        const Ggx ggx(alpha);
+        const vec3 m = ggx.sample_visible(wo, u);
+        s.wi = reflect(wo, m);
+        if (s.wi.z <= 0.f) return std::nullopt;  // reflected below the surface: no sample
+        auto [f, p] = eval_pdf(wo, s.wi);
+        if (!(p > 0.f)) return std::nullopt;
+        s.f = f;
+        s.pdf = p;
+        return s;
+    }
+    bool has_smooth_component() const { return !is_delta(); }
+
+private:
+    // Both from the same half vector, so that f / pdf is exactly R F G1(wi, h).
+    std::pair<vec3, float> eval_pdf(vec3 wo, vec3 wi) const {
+        const vec3 h = glm::normalize(wo + wi);
+        const Ggx ggx(alpha);
+        const float D = ggx.D(h);
+        const float g1o = ggx.G1(wo, h), g1i = ggx.G1(wi, h);
+        if (D == 0.f || g1o == 0.f || g1i == 0.f) return {vec3(0.f), 0.f};
+        const float c = D * g1o / (4.f * wo.z);
+        const vec3 F = fresnel_conductor(glm::dot(wo, h), eta, k);
+        return {specular_reflectance * F * (c * g1i), c};
+    }
+};
+
+}  // namespace candela

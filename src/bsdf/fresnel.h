@@ -1,0 +1,85 @@
+#pragma once
+// Fresnel equations and the mirror / refraction directions they go with, in the local shading
+// frame (n = +z). Unpolarised light throughout: reflectances are the mean of the s and p ones.
+#include <complex>
+#include <optional>
+#include <string>
+#include "core/math.h"
+
+namespace candela {
+
+// Mirror direction of w about the normal +z, and about a microfacet normal m (unit).
+inline vec3 reflect_z(vec3 w) { return vec3(-w.x, -w.y, w.z); }
+inline vec3 reflect(vec3 w, vec3 m) { return 2.f * glm::dot(w, m) * m - w; }
+
+// A smooth dielectric interface between an outside (+z side) and an inside (-z side) medium.
+struct FresnelDielectric {
+    float F = 1.f;       // reflectance, in [0, 1]; 1 under total internal reflection
+    float cos_t = 0.f;   // cosine of the transmitted direction, signed: on the other side than cos_i
+    float eta_it = 1.f;  // n_transmitted / n_incident: the relative IOR a refraction crosses
+    float eta_ti = 1.f;  // its inverse
+};
+
+// cos_i: cosine between the incident direction (pointing away from the surface) and the normal,
+// signed: positive when it lies outside. eta = n_inside / n_outside.
+inline FresnelDielectric fresnel_dielectric(float cos_i, float eta) {
+    FresnelDielectric r;
+    const bool outside = cos_i >= 0.f;
+    r.eta_it = outside ? eta : 1.f / eta;
+    r.eta_ti = outside ? 1.f / eta : eta;
+    const float ci = std::abs(cos_i);
+    // Snell: sin_t = sin_i * eta_ti.
+    const float cos_t2 = 1.f - (1.f - ci * ci) * r.eta_ti * r.eta_ti;
+    if (eta == 1.f) {  // index-matched: everything passes straight through
+        r.F = 0.f;
+        r.cos_t = -cos_i;
+        return r;
+    }
+    if (cos_t2 <= 0.f || ci == 0.f) {  // total internal reflection, or exactly grazing
+        r.F = 1.f;
+        r.cos_t = 0.f;
+        return r;
+    }
+    const float ct = std::sqrt(cos_t2);
+    // Amplitude ratios for the s (perpendicular) and p (parallel) polarisations.
+    const float rs = (ci - r.eta_it * ct) / (ci + r.eta_it * ct);
+    const float rp = (r.eta_it * ci - ct) / (r.eta_it * ci + ct);
+    r.F = 0.5f * (rs * rs + rp * rp);
+    r.cos_t = outside ? -ct : ct;
+    return r;
+}
+
+// Refraction of w (pointing away from the surface) through the microfacet normal m, with cos_t and
+// eta_ti from fresnel_dielectric(dot(w, m), eta). The result points away on the other side.
+inline vec3 refract(vec3 w, vec3 m, float cos_t, float eta_ti) {
+    return m * (glm::dot(w, m) * eta_ti + cos_t) - w * eta_ti;
+}
+
+// Reflectance of a conductor with complex IOR eta + i k (relative to the outside medium) for an
+// incident cosine cos_i in [0, 1], per colour channel. With (eta, k) = (0, 1), i.e. a purely
+// imaginary IOR, both polarisations reflect totally: F = 1 at every angle (Mitsuba's "none").
+inline float fresnel_conductor(float cos_i, float eta, float k) {
+    using C = std::complex<float>;
+    const C n(eta, k);
+    if (std::norm(n) == 0.f) return 1.f;
+    cos_i = std::clamp(cos_i, 0.f, 1.f);
+    const float sin2_i = 1.f - cos_i * cos_i;
+    const C cos_t = std::sqrt(C(1.f) - C(sin2_i) / (n * n));  // complex Snell's law
+    const C r_perp = (C(cos_i) - n * cos_t) / (C(cos_i) + n * cos_t);
+    const C r_parl = (n * C(cos_i) - cos_t) / (n * C(cos_i) + cos_t);
+    return 0.5f * (std::norm(r_perp) + std::norm(r_parl));
+}
+inline vec3 fresnel_conductor(float cos_i, vec3 eta, vec3 k) {
+    return vec3(fresnel_conductor(cos_i, eta.x, k.x), fresnel_conductor(cos_i, eta.y, k.y),
+                fresnel_conductor(cos_i, eta.z, k.z));
+}
+
+// Hemispherical average of the dielectric reflectance, 2 * integral of F(mu) mu dmu over [0, 1],
+// for light arriving from the side where eta = n_other / n_this (numerical quadrature; exact to
+// about 1e-6). Used by the plastic coat for the light bouncing back under the interface.
+float fresnel_diffuse_reflectance(float eta);
+
+// Index of refraction by name, as Mitsuba's int_ior / ext_ior accept them ("bk7", "air", ...).
+std::optional<float> ior_from_name(const std::string& name);
+
+}  // namespace candela
