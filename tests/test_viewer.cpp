@@ -352,6 +352,23 @@ TEST(ViewerWindow, ScreenshotShowsThePanelAndTheRender) {
         ASSERT_EQ(ref.w, size);
         refs.push_back(block_means(ref, 0, 0, size, size, block));
     }
+    // With the same seed the film is the same, sample for sample, so the window must show exactly
+    // the headless PNG: no flip, no shift, no resampling, no second tonemap.
+    {
+        std::string out = dir + "/same_seed.png";
+        CmdResult r = run_cmd(std::string("env -u DISPLAY ") + CANDELA_BIN + common + " --frames " +
+                              std::to_string(passes) + " -q --out " + out);
+        ASSERT_EQ(r.code, 0) << r.out;
+        Picture same;
+        ASSERT_TRUE(same.load(out));
+        ASSERT_EQ(same.w, size);
+        int differ = 0;
+        for (int y = 0; y < size; ++y)
+            for (int xx = 0; xx < size; ++xx)
+                for (int c = 0; c < 3; ++c) differ += pic.at(ix + xx, iy + y)[c] != same.at(xx, y)[c];
+        EXPECT_EQ(differ, 0) << "the window does not show the headless image of the same samples";
+    }
+
     const double floor = 0.5;  // bytes: rounding to 8 bits
     double p = family_p(viewer, refs, floor);
     EXPECT_GE(p, 0.01) << "the viewer's render differs from headless renders beyond noise";

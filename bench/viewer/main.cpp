@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     app.add_option("--duration", b.duration, "Seconds of measurement");
     app.add_option("--move-every", b.move_every, "Seconds between camera moves");
     app.add_option("--burst", b.moves_per_burst, "Frames per move that each change the camera");
+    app.add_flag("--paused", b.paused, "No full passes (previews after each camera change only)");
     CLI11_PARSE(app, argc, argv);
     vo.overrides.width = size;
     vo.overrides.height = size;

@@ -125,6 +125,15 @@ private:
     std::string loading_path_;
     std::vector<std::future<std::string>> saving_;
 
+    // The display shader's output for the current image, exposure and layout, kept in a texture:
+    // the shader runs when one of those changes, not every frame (it is most of a frame's cost
+    // in a software GL), and ImGui draws the texture pixel for pixel.
+    unsigned cache_fbo_ = 0, cache_tex_ = 0;
+    int cache_w_ = 0, cache_h_ = 0;
+    bool cache_valid_ = false;
+    float cache_exposure_ = 0;
+    void update_display_cache();
+
     int frame_ = 0;
     // Benchmark state.
     double bench_start_ = 0, bench_next_move_ = 0, bench_change_time_ = -1;
@@ -153,6 +162,7 @@ Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
     // Wakes the event loop when an image is ready: the window sleeps in glfwWaitEvents otherwise.
     session_->set_on_publish([] { glfwPostEmptyEvent(); });
     threads_ = session_->threads();
+    if (opt.benchmark && opt.benchmark->paused) session_->set_paused(true);
 }
 
 Viewer::~Viewer() {
@@ -163,6 +173,8 @@ Viewer::~Viewer() {
         glfwMakeContextCurrent(window_);
         saver_.reset();
         program_.reset();  // GL objects die with the context still current
+        if (cache_fbo_) gl_.DeleteFramebuffers(1, &cache_fbo_);
+        if (cache_tex_) gl_.DeleteTextures(1, &cache_tex_);
         if (imgui_ready_) {
             ImGui_ImplOpenGL3_Shutdown();
             ImGui_ImplGlfw_Shutdown();
@@ -447,7 +459,8 @@ void Viewer::panel() {
             last_sent_ = now();
         }
         ImGui::SameLine();
-        ImGui::TextDisabled(stats_.preview ? "preview" : stats_.idle ? (paused ? "paused" : "done") : "rendering");
+        const bool done = stats_.idle || (opt_.screenshot_after > 0 && stats_.passes >= opt_.screenshot_after);
+        ImGui::TextDisabled(paused ? "paused" : stats_.preview ? "preview" : done ? "done" : "rendering");
         ImGui::Text("%.0f spp  (%d passes)", stats_.spp, stats_.passes);
         ImGui::Text("%.2f s   %.3f Msamples/s   %.3f Mrays/s", stats_.elapsed, stats_.msamples_per_s,
                     stats_.mrays_per_s);
@@ -584,6 +597,36 @@ void Viewer::panel_pick() {
     ImGui::Text("distance  %.4g", pick_.distance);
 }
 
+void Viewer::update_display_cache() {
+    const int w = image_rect_.width, h = image_rect_.height;
+    if (image_.rgb.empty() || w <= 0 || h <= 0) return;
+    if (cache_valid_ && w == cache_w_ && h == cache_h_ && display_.exposure == cache_exposure_) return;
+    if (w != cache_w_ || h != cache_h_) {
+        if (!cache_tex_) gl_.GenTextures(1, &cache_tex_);
+        if (!cache_fbo_) gl_.GenFramebuffers(1, &cache_fbo_);
+        gl_.BindTexture(GL_TEXTURE_2D, cache_tex_);
+        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+        // Nearest: drawn at its own size, each window pixel takes its texel unchanged.
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, cache_fbo_);
+        gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cache_tex_, 0);
+        GLenum status = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER);
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("viewer: the display cache framebuffer is incomplete");
+        cache_w_ = w;
+        cache_h_ = h;
+    }
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, cache_fbo_);
+    program_->draw({0, 0, w, h}, display_, image_.preview ? DisplayFilter::Linear : DisplayFilter::Nearest);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    check_gl_error(gl_, "display cache");
+    cache_valid_ = true;
+    cache_exposure_ = display_.exposure;
+}
+
 bool Viewer::write_screenshot() {
     // The window's own framebuffer, panel included, before the swap.
     std::vector<unsigned char> rgba(size_t(fb_w_) * size_t(fb_h_) * 4), flipped(rgba.size());
@@ -609,7 +652,7 @@ void Viewer::benchmark_step(double frame_start) {
     double t = now();
     if (bench_start_ == 0) {
         // Start once the first full pass is on screen: the steady state of a session.
-        if (image_.preview || image_.rgb.empty()) return;
+        if (image_.rgb.empty() || (image_.preview && !b.paused)) return;
         bench_start_ = t;
         bench_next_move_ = t;
     }
@@ -645,7 +688,10 @@ int Viewer::run() {
         frame_start = now();
 
         poll_background_work();
-        if (session_->take_image(image_)) program_->upload(image_.width, image_.height, image_.rgb.data());
+        if (session_->take_image(image_)) {
+            program_->upload(image_.width, image_.height, image_.rgb.data());
+            cache_valid_ = false;
+        }
         stats_ = session_->stats();
 
         ImGui_ImplOpenGL3_NewFrame();
@@ -672,13 +718,21 @@ int Viewer::run() {
         }
         panel();
         flush_updates();
+        if (!image_.rgb.empty()) {
+            // Top-left origin in window coordinates; the cache's row 0 is the image's bottom row.
+            const float x0 = float(image_rect_.x) / fb_scale_;
+            const float y0 = float(fb_h_ - image_rect_.y - image_rect_.height) / fb_scale_;
+            ImGui::GetBackgroundDrawList()->AddImage(
+                reinterpret_cast<ImTextureID>(intptr_t(cache_tex_)), ImVec2(x0, y0),
+                ImVec2(x0 + float(image_rect_.width) / fb_scale_, y0 + float(image_rect_.height) / fb_scale_),
+                ImVec2(0.f, 1.f), ImVec2(1.f, 0.f));
+        }
         ImGui::Render();
 
+        update_display_cache();
         gl_.Viewport(0, 0, fb_w_, fb_h_);
         gl_.ClearColor(0.02f, 0.02f, 0.02f, 1.f);
         gl_.Clear(GL_COLOR_BUFFER_BIT);
-        if (!image_.rgb.empty())
-            program_->draw(image_rect_, display_, image_.preview ? DisplayFilter::Linear : DisplayFilter::Nearest);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         ++frame_;
 

@@ -15,6 +15,7 @@ struct ViewerBenchmark {
     double duration = 10;       // seconds of measurement, after the first full-resolution pass
     double move_every = 0.25;   // seconds between scripted camera changes (a small orbit step)
     int moves_per_burst = 1;    // consecutive frames that each change the camera (a "drag")
+    bool paused = false;        // full passes paused: the window's own cost, previews only
     // Results.
     std::vector<double> frame_ms;   // UI work per frame: events, panel, upload, draw, swap
     std::vector<double> update_ms;  // camera change -> end of the first frame showing its image
