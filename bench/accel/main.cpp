@@ -125,25 +125,28 @@ void bisect(Mesh& m, uint32_t round) {
     m.tri_shape.assign(m.triangles.size(), 0);
 }
 
-void add_box(Mesh& m, vec3 lo, vec3 hi) {
+// An axis-aligned box as 12 triangles; `open_top` leaves out the +y face.
+void add_box(Mesh& m, vec3 lo, vec3 hi, bool open_top = false) {
     uint32_t base = uint32_t(m.positions.size());
     for (int k = 0; k < 8; ++k) m.positions.emplace_back(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
     const uint32_t f[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
-    for (const auto& q : f) {
+    for (int i = 0; i < 6; ++i) {
+        if (open_top && i == 3) continue;
+        const auto& q = f[i];
         m.triangles.emplace_back(base + q[0], base + q[1], base + q[2]);
         m.triangles.emplace_back(base + q[0], base + q[2], base + q[3]);
     }
 }
 
-// "Teapot in a stadium": the mesh stays where it is; around it goes an arena 100x its size (floor,
-// walls, roof: a box) with 200 sparse pillars. A few thousand big triangles around a dense core.
+// "Teapot in a stadium": the mesh stays where it is; around it goes an arena 100x its size (a
+// floor and walls, open to the sky so that the camera sees in) with 200 sparse pillars: a few
+// thousand big triangles around one dense core.
 void add_stadium(Mesh& m) {
     AABB b = m.bounds();
     float diag = glm::length(b.extent());
     vec3 c = b.center();
     float half = 50.f * diag;
-    vec3 lo(c.x - half, b.min.y, c.z - half), hi(c.x + half, b.min.y + 20.f * diag, c.z + half);
-    add_box(m, lo, hi);
+    add_box(m, vec3(c.x - half, b.min.y, c.z - half), vec3(c.x + half, b.min.y + 10.f * diag, c.z + half), true);
     for (uint32_t i = 0; i < 200; ++i) {
         float x = c.x + (u01(hash_u32(2 * i + 1)) * 2.f - 1.f) * 0.9f * half;
         float z = c.z + (u01(hash_u32(2 * i + 2)) * 2.f - 1.f) * 0.9f * half;
