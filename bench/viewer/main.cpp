@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
                 threads, b.duration, b.frames, b.update_ms.size());
     std::printf("frame  ms: median %.2f  p90 %.2f  p99 %.2f  max %.2f\n", percentile(b.frame_ms, 0.5),
                 percentile(b.frame_ms, 0.9), percentile(b.frame_ms, 0.99), percentile(b.frame_ms, 1.0));
+    std::printf("frame  CPU ms (window thread): median %.2f  p90 %.2f  p99 %.2f\n", percentile(b.frame_cpu_ms, 0.5),
+                percentile(b.frame_cpu_ms, 0.9), percentile(b.frame_cpu_ms, 0.99));
     std::printf("update ms: median %.2f  p90 %.2f  max %.2f\n", percentile(b.update_ms, 0.5),
                 percentile(b.update_ms, 0.9), percentile(b.update_ms, 1.0));
     return 0;

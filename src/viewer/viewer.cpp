@@ -7,6 +7,7 @@
 #include <imgui.h>
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <future>
 #include <thread>
@@ -34,6 +35,12 @@ constexpr double kInteractiveHold = 0.2;
 constexpr double kMaxUpdateDelay = 0.1;
 // While something animates (fly keys held), frames are paced at this rate.
 constexpr double kFrameInterval = 1.0 / 60.0;
+
+double thread_cpu_seconds() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
@@ -75,7 +82,7 @@ private:
     void save_exr(const std::string& path);
     void set_status(const std::string& s, bool error) { status_ = s, status_error_ = error; }
     bool write_screenshot();
-    void benchmark_step(double frame_start);
+    void benchmark_step(double frame_start, double frame_cpu_start);
 
     ViewerOptions opt_;
     GLFWwindow* window_ = nullptr;
@@ -647,7 +654,7 @@ bool Viewer::write_screenshot() {
     return true;
 }
 
-void Viewer::benchmark_step(double frame_start) {
+void Viewer::benchmark_step(double frame_start, double frame_cpu_start) {
     ViewerBenchmark& b = *opt_.benchmark;
     double t = now();
     if (bench_start_ == 0) {
@@ -661,6 +668,7 @@ void Viewer::benchmark_step(double frame_start) {
         return;
     }
     b.frame_ms.push_back((t - frame_start) * 1e3);
+    b.frame_cpu_ms.push_back((thread_cpu_seconds() - frame_cpu_start) * 1e3);
     ++b.frames;
     // A change is "shown" at the end of the first frame whose image comes from it.
     if (bench_change_time_ >= 0 && !bench_waiting_gen_ && image_.generation >= bench_change_gen_) {
@@ -686,6 +694,7 @@ int Viewer::run() {
         else glfwPollEvents();
         if (glfwWindowShouldClose(window_)) break;
         frame_start = now();
+        const double frame_cpu_start = opt_.benchmark ? thread_cpu_seconds() : 0.0;
 
         poll_background_work();
         if (session_->take_image(image_)) {
@@ -742,7 +751,7 @@ int Viewer::run() {
         if (shot) write_screenshot();
         glfwSwapBuffers(window_);
         if (shot) return 0;
-        if (opt_.benchmark) benchmark_step(frame_start);
+        if (opt_.benchmark) benchmark_step(frame_start, frame_cpu_start);
     }
     return 0;
 }

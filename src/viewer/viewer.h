@@ -18,6 +18,9 @@ struct ViewerBenchmark {
     bool paused = false;        // full passes paused: the window's own cost, previews only
     // Results.
     std::vector<double> frame_ms;   // UI work per frame: events, panel, upload, draw, swap
+    std::vector<double> frame_cpu_ms;  // the same, in CPU time of the window's thread: what the
+                                       // frame costs on an idle core (with LP_NUM_THREADS=0 the
+                                       // software rasteriser runs in this thread too)
     std::vector<double> update_ms;  // camera change -> end of the first frame showing its image
     int frames = 0;
 };
