@@ -8,6 +8,7 @@
 #include <tiny_obj_loader.h>
 #include <array>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -20,6 +21,10 @@ namespace candela {
 namespace {
 
 std::string read_text_file(const std::string& path) {
+    // A directory opens like a file and then reads as empty (the read error is swallowed by the
+    // stream), which would be reported as an "empty OBJ file".
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw Error(path, 0, "is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");
     std::ostringstream ss;
