@@ -15,11 +15,18 @@ struct HeadlessOptions {
     double time_limit = 0;    // seconds; 0: none
     DisplaySettings display;
     bool quiet = false;
+    // Checkpoints (see app/checkpoint.h): saved to `checkpoint` every `checkpoint_every` seconds
+    // (0: after every pass), at the end and when stopped by a signal; `resume` continues from one.
+    std::string checkpoint;
+    double checkpoint_every = 60;
+    std::string resume;
 };
 
 // Renders the passes, shows progress (a bar on a terminal, a summary line otherwise), and writes
-// the image. SIGINT/SIGTERM stop the render early; the image so far is still written. Returns the
-// process exit code.
+// the image. SIGINT/SIGTERM stop the render early: the image so far is still written and the
+// summary says how many spp it has. With a checkpoint file the first signal lets the current pass
+// finish (a checkpoint holds whole passes) and a second one stops at once. Returns the process
+// exit code: 0, or 128 + the signal's number when stopped by one.
 int run_headless(const HeadlessOptions& opt);
 
 }  // namespace candela

@@ -39,6 +39,18 @@ int main(int argc, char** argv) {
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
     app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
+    auto* ck_opt = app.add_option("--checkpoint", opt.checkpoint,
+                                  "Headless: save the render's state to FILE (atomically) periodically, at the end and "
+                                  "when stopped by a signal")
+                       ->type_name("FILE");
+    app.add_option("--checkpoint-every", opt.checkpoint_every,
+                   "Seconds between checkpoints (default 60; 0: after every pass)")
+        ->check(CLI::NonNegativeNumber)
+        ->needs(ck_opt);
+    auto* resume_opt = app.add_option("--resume", opt.resume,
+                                      "Headless: continue the render saved in checkpoint FILE (same scene and options; "
+                                      "--frames is the total)")
+                           ->type_name("FILE");
     // --screenshot-after N FILE: one option with two values (a pair: CLI11 checks both types).
     std::pair<int, std::string> shot_args{0, ""};
     auto* shot = app.add_option("--screenshot-after", shot_args,
@@ -70,6 +82,7 @@ int main(int argc, char** argv) {
         bool has_display = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
 #ifdef CANDELA_HAS_VIEWER
         if (opt.out.empty() && (has_display || *shot)) {
+            if (*ck_opt || *resume_opt) throw Error("--checkpoint and --resume are for headless renders: give --out");
             ViewerOptions vo;
             vo.scene = opt.scene;
             vo.overrides = ov;
@@ -83,6 +96,7 @@ int main(int argc, char** argv) {
         }
 #else
         (void)shot;
+        (void)resume_opt;
 #endif
         if (opt.out.empty()) {
             opt.out = "candela.png";
