@@ -193,7 +193,9 @@ TEST(Session, PauseStopsFullPassesAndResetRestarts) {
     RenderSession session(cornell(32, 32), opt);
     ASSERT_TRUE(session.wait_for(0, 2, 60));
     session.set_paused(true);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the pass in flight completes
+    // The pass in flight completes, then the worker rests.
+    for (int i = 0; i < 1000 && !session.stats().idle; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_TRUE(session.stats().idle);
     int p0 = session.stats().passes;
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     EXPECT_EQ(session.stats().passes, p0);
