@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <string>
 #include <unordered_map>
@@ -30,6 +31,14 @@
 using namespace candela;
 
 namespace {
+
+// CPU time of the calling thread: with --threads 1 the rays are traced on it, and on a shared
+// machine this figure does not count the time other processes held the core.
+double thread_cpu_now() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 double now() {
     using namespace std::chrono;
@@ -216,6 +225,7 @@ std::vector<RayRecord> bounce_rays(const Mesh& mesh, const Accel& accel, const s
 
 struct Result {
     double mrays = 0.0;
+    double cpu_mrays = 0.0;  // one thread: per second of this thread's CPU time (see trace())
     uint64_t hits = 0;
     double sum_t = 0.0;
 };
@@ -224,9 +234,9 @@ struct Result {
 Result trace(const Accel& accel, const std::vector<RayRecord>& rays, bool any_hit, int threads, int repeat) {
     const int64_t n = int64_t(rays.size());
     std::vector<float> t(rays.size());
-    double best = 1e30;
+    double best = 1e30, best_cpu = 1e30;
     for (int rep = 0; rep < repeat; ++rep) {
-        double t0 = now();
+        double t0 = now(), c0 = thread_cpu_now();
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
         for (int64_t i = 0; i < n; ++i) {
             Ray r = to_ray(rays[size_t(i)]);
@@ -238,9 +248,11 @@ Result trace(const Accel& accel, const std::vector<RayRecord>& rays, bool any_hi
             }
         }
         best = std::min(best, now() - t0);
+        best_cpu = std::min(best_cpu, thread_cpu_now() - c0);
     }
     Result res;
     res.mrays = double(n) / best / 1e6;
+    if (threads == 1) res.cpu_mrays = double(n) / best_cpu / 1e6;
     for (float x : t)
         if (x >= 0.f) {
             ++res.hits;
@@ -357,7 +369,16 @@ int main(int argc, char** argv) try {
         std::vector<RayRecord> rays = read_rays(rays_path);
         for (const std::string& name : accels) {
             Built b = build(name, mesh);
+            kd_trace_counters() = {};
             Result r = trace(*b.accel, rays, false, nthreads, repeat);
+            if (r.cpu_mrays > 0.0)
+                std::fprintf(stderr, "[%s] %.3f Mrays/s per second of thread CPU time\n", name.c_str(), r.cpu_mrays);
+#ifdef CANDELA_KD_COUNTERS
+            if (const KdTraceCounters& c = kd_trace_counters(); c.rays > 0)
+                std::fprintf(stderr, "[%s] per ray: %.2f nodes, %.2f leaves, %.2f triangle tests (1 thread only)\n",
+                             name.c_str(), double(c.nodes) / double(c.rays), double(c.leaves) / double(c.rays),
+                             double(c.tris) / double(c.rays));
+#endif
             std::printf("accel=%s rays=%zu hits=%llu sum_t=%.9e build_s=%.4f mrays_per_s=%.3f\n", name.c_str(),
                         rays.size(), (unsigned long long)r.hits, r.sum_t, b.build_s, r.mrays);
             std::fflush(stdout);

@@ -1,5 +1,6 @@
 #include "accel/kdtree.h"
 #include <omp.h>
+#include <immintrin.h>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -316,27 +317,41 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     }
 
     // Flatten depth first: the first child follows its parent, so interior nodes store only the
-    // index of the second.
+    // index of the second. Triangles get their slot in tris_ when a leaf first meets them.
     struct Flatten {
         KdTree& t;
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
+        std::vector<uint32_t> slot;  // builder-local triangle -> slot in t.tris_
+        uint32_t slot_of(uint32_t p) {
+            if (slot[p] == UINT32_MAX) {
+                slot[p] = uint32_t(t.tris_.size());
+                Tri tri;
+                tri.prim = list[p];
+                mesh.vertices(tri.prim, tri.p0, tri.p1, tri.p2);
+                t.tris_.push_back(tri);
+            }
+            return slot[p];
+        }
         void operator()(const BuildNode& bn, int depth) {
             const size_t idx = t.nodes_.size();
             t.nodes_.emplace_back();
             t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
             if (bn.axis < 0) {
-                Node& nd = t.nodes_[idx];
-                nd.first = uint32_t(t.tris_.size());
-                nd.bits = (uint32_t(bn.prims.size()) << 2) | 3u;
-                for (uint32_t p : bn.prims) {
-                    LeafTri lt;
-                    lt.prim = list[p];
-                    mesh.vertices(lt.prim, lt.p0, lt.p1, lt.p2);
-                    t.tris_.push_back(lt);
+                const size_t n = bn.prims.size();
+                uint32_t first = 0;
+                if (n == 1) {
+                    first = slot_of(bn.prims[0]);
+                } else if (n > 1) {
+                    first = uint32_t(t.refs_.size());
+                    for (uint32_t p : bn.prims) t.refs_.push_back(slot_of(p));
                 }
+                Node& nd = t.nodes_[idx];
+                nd.first = first;
+                nd.bits = (uint32_t(n) << 2) | 3u;
                 ++t.stats_.leaves;
-                if (bn.prims.empty()) ++t.stats_.empty_leaves;
+                t.stats_.references += n;
+                if (n == 0) ++t.stats_.empty_leaves;
                 return;
             }
             (*this)(*bn.child[0], depth + 1);
@@ -347,23 +362,42 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             nd.bits = (above << 2) | uint32_t(bn.axis);
         }
     };
-    Flatten{*this, mesh, list}(*root, 0);
+    Flatten{*this, mesh, list, std::vector<uint32_t>(list.size(), UINT32_MAX)}(*root, 0);
     nodes_.shrink_to_fit();
     tris_.shrink_to_fit();
+    refs_.shrink_to_fit();
     stats_.nodes = nodes_.size();
-    stats_.references = tris_.size();
 }
 
 size_t KdTree::memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + tris_.capacity() * sizeof(LeafTri);
+    return nodes_.capacity() * sizeof(Node) + tris_.capacity() * sizeof(Tri) + refs_.capacity() * sizeof(uint32_t);
 }
+
+KdTraceCounters& kd_trace_counters() {
+    static thread_local KdTraceCounters c;
+    return c;
+}
+
+#ifdef CANDELA_KD_COUNTERS
+#define KD_COUNT(field, n) (kd_trace_counters().field += (n))
+#else
+#define KD_COUNT(field, n) ((void)0)
+#endif
 
 namespace {
 
 // Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
     float o[3], d[3], inv_d[3];
+    int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide edge test
+    float sx, sy;
     explicit RayData(const Ray& ray) {
+        const RayShear sh(ray.d);
+        kx = sh.kx;
+        ky = sh.ky;
+        kz = sh.kz;
+        sx = sh.sx;
+        sy = sh.sy;
         for (int i = 0; i < 3; ++i) {
             o[i] = ray.o[i];
             d[i] = ray.d[i];
@@ -372,11 +406,50 @@ struct RayData {
     }
 };
 
+// The first half of intersect_triangle() (geometry/triangle.h) on four triangles at once: the
+// translation, the shear and the three edge functions, with the same float operations in the
+// same order (no FMA at -march=x86-64-v2), so each lane's edge values are bit-identical to the
+// scalar test's. Returns the lanes that test would not reject at its edge-sign check (any edge
+// exactly 0 -- redone in double there -- or NaN counts as not rejected); the caller runs the
+// scalar test on those, so the filter decides nothing the shared test would not.
+inline unsigned edge_filter4(const RayData& r, const KdTree::Tri* const t[4]) {
+    __m128 p[3][3];  // p[vertex][axis], four triangles per register
+    for (int v = 0; v < 3; ++v) {
+        __m128 r0 = _mm_loadu_ps(&t[0]->p0.x + 3 * v), r1 = _mm_loadu_ps(&t[1]->p0.x + 3 * v);
+        __m128 r2 = _mm_loadu_ps(&t[2]->p0.x + 3 * v), r3 = _mm_loadu_ps(&t[3]->p0.x + 3 * v);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        p[v][0] = r0;
+        p[v][1] = r1;
+        p[v][2] = r2;
+    }
+    const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy);
+    __m128 x[3], y[3];
+    for (int v = 0; v < 3; ++v) {
+        // a = p - o, then a[kx] + sx * a[kz] and a[ky] + sy * a[kz].
+        const __m128 ax = _mm_sub_ps(p[v][r.kx], _mm_set1_ps(r.o[r.kx]));
+        const __m128 ay = _mm_sub_ps(p[v][r.ky], _mm_set1_ps(r.o[r.ky]));
+        const __m128 az = _mm_sub_ps(p[v][r.kz], _mm_set1_ps(r.o[r.kz]));
+        x[v] = _mm_add_ps(ax, _mm_mul_ps(sx, az));
+        y[v] = _mm_add_ps(ay, _mm_mul_ps(sy, az));
+    }
+    const __m128 e0 = _mm_sub_ps(_mm_mul_ps(x[1], y[2]), _mm_mul_ps(y[1], x[2]));
+    const __m128 e1 = _mm_sub_ps(_mm_mul_ps(x[2], y[0]), _mm_mul_ps(y[2], x[0]));
+    const __m128 e2 = _mm_sub_ps(_mm_mul_ps(x[0], y[1]), _mm_mul_ps(y[0], x[1]));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
+    const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)), _mm_cmpgt_ps(e2, zero));
+    const __m128 any_zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero));
+    // Rejected: some edge negative and some positive, and none exactly zero.
+    const __m128 rejected = _mm_andnot_ps(any_zero, _mm_and_ps(any_neg, any_pos));
+    return unsigned(~_mm_movemask_ps(rejected)) & 15u;
+}
+
 }  // namespace
 
 template <bool Shadow>
 bool KdTree::trace(Ray& ray, Hit* hit) const {
     if (nodes_.empty()) return false;
+    KD_COUNT(rays, 1);
     const RayData r(ray);
     const RayShear sh(ray.d);
     float t0, t1;
@@ -393,6 +466,7 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     float tmax = ray.tmax;
     bool found = false;
     for (;;) {
+        KD_COUNT(nodes, 1);
         if (!node->leaf()) {
             const int a = node->axis();
             const float split = node->split;
@@ -421,21 +495,38 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         }
 
         const uint32_t count = node->count();
-        const LeafTri* lt = tris_.data() + node->first;
-        for (uint32_t i = 0; i < count; ++i, ++lt) {
+        KD_COUNT(leaves, 1);
+        KD_COUNT(tris, count);
+        // Tests one triangle with the shared watertight test itself, so that every hit is
+        // bit-identical to brute force.
+        auto test = [&](const Tri* lt) {
             TriangleHit th;
-            // The shared watertight test itself, so that hits are bit-identical to brute force.
-            if (intersect_triangle(ray, sh, lt->p0, lt->p1, lt->p2, th)) {
-                if constexpr (Shadow) {
-                    return true;
-                } else {
-                    tmax = th.t;
-                    ray.tmax = th.t;
-                    hit->t = th.t;
-                    hit->b1 = th.b1;
-                    hit->b2 = th.b2;
-                    hit->prim = lt->prim;
-                    found = true;
+            if (!intersect_triangle(ray, sh, lt->p0, lt->p1, lt->p2, th)) return false;
+            if constexpr (!Shadow) {
+                tmax = th.t;
+                ray.tmax = th.t;
+                hit->t = th.t;
+                hit->b1 = th.b1;
+                hit->b2 = th.b2;
+                hit->prim = lt->prim;
+                found = true;
+            }
+            return true;
+        };
+        if (count == 1) {
+            if (test(tris_.data() + node->first) && Shadow) return true;
+        } else {
+            const uint32_t* slots = refs_.data() + node->first;
+            for (uint32_t i = 0; i < count; i += 4) {
+                const Tri* t4[4];
+                const uint32_t n4 = std::min(count - i, 4u);
+                for (uint32_t k = 0; k < 4; ++k) t4[k] = tris_.data() + slots[i + std::min(k, n4 - 1)];
+                // Only the lanes that the 4-wide edge test cannot reject go to the scalar test.
+                unsigned mask = edge_filter4(r, t4) & ((1u << n4) - 1u);
+                while (mask) {
+                    const int k = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    if (test(t4[k]) && Shadow) return true;
                 }
             }
         }

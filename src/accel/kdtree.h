@@ -8,8 +8,8 @@
 // clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
 //
 // Traversal: 8-byte nodes, a fixed-size stack, template <bool Shadow> for the any-hit variant.
-// Leaves point into an array of triangle copies (three vertices + the triangle index), so a leaf
-// test reads one contiguous block instead of chasing index -> vertex pointers. Every triangle test
+// Leaves hold one triangle slot inline or a list of slots into one array of triangle copies
+// (three vertices + the triangle index, one copy per triangle). Every triangle test
 // is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the same t,
 // bit for bit, as the brute-force oracle.
 #include <cstdint>
@@ -35,6 +35,13 @@ struct KdTreeStats {
     int max_depth = 0;
 };
 
+// Traversal counters for tuning, compiled in only with -DCANDELA_KD_COUNTERS (per thread; the
+// benchmark prints them per ray). Without the flag they stay zero and cost nothing.
+struct KdTraceCounters {
+    uint64_t rays = 0, nodes = 0, leaves = 0, tris = 0;
+};
+KdTraceCounters& kd_trace_counters();
+
 // The tree itself, without the Accel vtable: the hybrid grid holds one per cell.
 class KdTree {
 public:
@@ -57,8 +64,9 @@ public:
     const KdTreeStats& stats() const { return stats_; }
 
     // Compact node: an interior node keeps the split position and the index of its second
-    // ("above") child (the first follows it directly); a leaf keeps its first slot in tris_ and
-    // its triangle count.
+    // ("above") child (the first follows it directly). A leaf keeps its triangle count and
+    // `first`: the triangle's slot in tris_ itself when it holds one triangle (no indirection
+    // for the commonest leaf), else the offset of its slot list in refs_.
     struct Node {
         union {
             float split;
@@ -72,8 +80,9 @@ public:
     };
     static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
 
-    // One leaf reference: a copy of the triangle's vertices, so the leaf test needs no indirection.
-    struct LeafTri {
+    // One triangle's vertices (copied once per triangle, not per leaf reference), in the order
+    // the depth-first node layout first meets them, so that neighbouring leaves share lines.
+    struct Tri {
         vec3 p0, p1, p2;
         uint32_t prim;
     };
@@ -83,7 +92,8 @@ private:
     bool trace(Ray& ray, Hit* hit) const;
 
     std::vector<Node> nodes_;
-    std::vector<LeafTri> tris_;
+    std::vector<Tri> tris_;
+    std::vector<uint32_t> refs_;  // slot lists of the leaves with two or more triangles
     AABB bounds_;
     KdTreeStats stats_;
 };
