@@ -1,0 +1,118 @@
+// Multiple importance sampling on the Veach MIS scene (scenes/veach-mis): light sampling, BSDF
+// sampling and their power-heuristic combination must estimate the same image (block z-test), and
+// at equal sample counts MIS must have the lowest error. The scene mixes all the cases: smooth
+// plates (alpha 0.005) with small lights favour BSDF sampling, rough plates with large lights
+// favour light sampling. A second scene checks MIS through delta and mixed lobes (mirror, glass,
+// smooth plastic: the Cornell material variants).
+#include <gtest/gtest.h>
+#include <cstdio>
+#include <memory>
+#include "film/film.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "support/stats.h"
+
+using namespace candela;
+using namespace candela::stats;
+
+namespace {
+
+constexpr double kAlpha = 0.01;
+
+std::unique_ptr<Scene> load(const std::string& rel, int w, int h, int max_depth) {
+    auto s = std::make_unique<Scene>(load_scene(std::string(CANDELA_SOURCE_DIR) + "/" + rel));
+    s->settings.width = w;
+    s->settings.height = h;
+    s->settings.max_depth = max_depth;
+    s->finalize();
+    return s;
+}
+
+// K independent batches of spp samples each, for the batch-means variance of every pixel.
+ImageEstimate render(Scene& s, SamplingMode mode, int batches, int spp) {
+    s.settings.sampling = mode;
+    std::vector<std::unique_ptr<Film>> films;
+    std::vector<const Film*> ptrs;
+    for (int b = 0; b < batches; ++b) {
+        films.push_back(std::make_unique<Film>(s.settings.width, s.settings.height));
+        Renderer::render_pass(s, *films.back(), uint32_t(b * spp), spp, 0);
+        ptrs.push_back(films.back().get());
+    }
+    return ImageEstimate::from_batches(ptrs);
+}
+
+// The estimator's error at this sample count: the mean over pixels of the variance of the pixel
+// mean (all three estimators are unbiased, as the z-tests check, so this is their mean squared
+// error), relative to the squared mean brightness.
+double relative_mse(const ImageEstimate& e) {
+    double v = 0.0, m = 0.0;
+    for (size_t i = 0; i < e.mean.size(); ++i) {
+        v += (e.var_of_mean[i].x + e.var_of_mean[i].y + e.var_of_mean[i].z) / 3.0;
+        m += (e.mean[i].x + e.mean[i].y + e.mean[i].z) / 3.0;
+    }
+    m /= double(e.mean.size());
+    return v / double(e.mean.size()) / (m * m);
+}
+
+struct Result {
+    ImageEstimate light, bsdf, mis;
+};
+
+Result render_all(Scene& s, int batches, int spp) {
+    Result r;
+    r.light = render(s, SamplingMode::Light, batches, spp);
+    r.bsdf = render(s, SamplingMode::Bsdf, batches, spp);
+    r.mis = render(s, SamplingMode::Mis, batches, spp);
+    return r;
+}
+
+void check_agreement(const Result& r, const char* scene, int block = 8) {
+    const double level = sidak_level(kAlpha, 3);
+    BlockTestResult lm = block_z_test(r.light, r.mis, block, level);
+    BlockTestResult bm = block_z_test(r.bsdf, r.mis, block, level);
+    BlockTestResult lb = block_z_test(r.light, r.bsdf, block, level);
+    EXPECT_TRUE(lm.passed(level)) << scene << " light vs mis: " << lm.describe();
+    EXPECT_TRUE(bm.passed(level)) << scene << " bsdf vs mis: " << bm.describe();
+    EXPECT_TRUE(lb.passed(level)) << scene << " light vs bsdf: " << lb.describe();
+    std::printf("  %s light vs mis: %s\n  %s bsdf vs mis:  %s\n  %s light vs bsdf: %s\n", scene, lm.describe().c_str(),
+                scene, bm.describe().c_str(), scene, lb.describe().c_str());
+}
+
+}  // namespace
+
+TEST(Mis, VeachSceneStrategiesAgreeAndMisWins) {
+    // Direct lighting only (one scattering event): where the strategies differ most.
+    // Agreement: BSDF sampling of the smallest light from the roughest plate, and light sampling
+    // of the smoothest plate, are the heavy-tailed estimators Veach's figure is about; a z-test
+    // needs many such hits per block to be in its normal regime. So: large blocks (16 x 16 pixels
+    // of a 48 x 32 image), 1024 samples per pixel in 16 batches, and the smoothest plates made
+    // alpha 0.05: at alpha 0.01, light sampling still misses its rare spikes at 1024 spp (measured:
+    // -2.7 % at 8192 spp, +1.3 % at 65536 spp against MIS on the brightest block: noise, not bias).
+    {
+        auto a = load("scenes/veach-mis/scene.xml", 48, 32, 1);
+        for (Material& m : a->materials)
+            if (auto* c = std::get_if<ConductorBsdf>(&m.bsdf)) c->alpha = std::max(c->alpha, 0.05f);
+        Result r = render_all(*a, 16, 64);
+        check_agreement(r, "veach", 16);
+    }
+    // Error at equal sample counts, on a finer image.
+    auto s = load("scenes/veach-mis/scene.xml", 96, 64, 1);
+    Result r = render_all(*s, 16, 8);
+    double el = relative_mse(r.light), eb = relative_mse(r.bsdf), em = relative_mse(r.mis);
+    std::printf("  veach-mis, 96x64, 128 spp, direct light: relative MSE  light %.4g  bsdf %.4g  mis %.4g"
+                "  (mis is %.1fx better than light, %.1fx than bsdf)\n", el, eb, em, el / em, eb / em);
+    EXPECT_LT(em, el);
+    EXPECT_LT(em, eb);
+}
+
+TEST(Mis, DeltaAndMixedLobes) {
+    // Mirror and glass blocks (delta lobes only: light sampling is skipped there) and a smooth
+    // plastic (a delta coat over a diffuse base) with a rough glass block; full global illumination.
+    for (const char* f : {"scenes/cornell-materials/mirror-glass.xml", "scenes/cornell-materials/glossy-glass.xml"}) {
+        auto s = load(f, 48, 48, 6);
+        Result r = render_all(*s, 8, 16);
+        check_agreement(r, f);
+        std::printf("  %s: relative MSE  light %.4g  bsdf %.4g  mis %.4g\n", f, relative_mse(r.light), relative_mse(r.bsdf),
+                    relative_mse(r.mis));
+    }
+}
