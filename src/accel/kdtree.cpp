@@ -257,12 +257,12 @@ private:
     std::vector<std::vector<uint8_t>> flags_;  // per thread: side of each triangle at the current node
 };
 
-// Sign-aware widening of a ray parameter by about 2^-16 of its size: room for the rounding of
-// split-plane distances and of triangle hit distances (both a few ulps) so that the traversal
-// never culls a node that brute force would find a hit in.
-constexpr float kSlack = 1.f / 65536.f;
-inline float widen_down(float t) { return t - kSlack * std::fabs(t); }
-inline float widen_up(float t) { return t + kSlack * std::fabs(t); }
+// Widening of a ray parameter by 2^-16 of its size: room for the rounding of split-plane
+// distances and of triangle hit distances (both a few ulps) so that the traversal never culls a
+// node that brute force would find a hit in. The traversal keeps every parameter >= 0 (hits have
+// t > 0), so a single multiplication widens.
+constexpr float kWidenUp = 1.f + 1.f / 65536.f;
+constexpr float kWidenDown = 1.f - 1.f / 65536.f;
 
 }  // namespace
 
@@ -316,8 +316,12 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         root = builder.build(events, n, bounds_, 0, 0);
     }
 
-    // Flatten depth first: the first child follows its parent, so interior nodes store only the
-    // index of the second. Triangles get their slot in tris_ when a leaf first meets them.
+    // Layout: the two children of a node are adjacent (a sibling pair), so an interior node stores
+    // one index. Pairs are packed in treelets of up to 4 pairs (8 nodes, 64 bytes), filled breadth
+    // first: a pair, its children's pairs, one more. A ray descending through a treelet's 2-3
+    // levels then touches one or two cache lines instead of one per level, which is what
+    // incoherent rays pay for: the deep levels are never in cache. Treelets follow each other in
+    // depth-first order; a leaf's triangles get their slot in tris_ when a leaf first meets them.
     struct Flatten {
         KdTree& t;
         const Mesh& mesh;
@@ -333,36 +337,69 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             }
             return slot[p];
         }
-        void operator()(const BuildNode& bn, int depth) {
-            const size_t idx = t.nodes_.size();
-            t.nodes_.emplace_back();
+        // Writes a leaf, or an interior node whose children index is patched when its pair is placed.
+        void write(uint32_t idx, const BuildNode* bn, int depth) {
             t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
-            if (bn.axis < 0) {
-                const size_t n = bn.prims.size();
-                uint32_t first = 0;
-                if (n == 1) {
-                    first = slot_of(bn.prims[0]);
-                } else if (n > 1) {
-                    first = uint32_t(t.refs_.size());
-                    for (uint32_t p : bn.prims) t.refs_.push_back(slot_of(p));
-                }
-                Node& nd = t.nodes_[idx];
-                nd.first = first;
-                nd.bits = (uint32_t(n) << 2) | 3u;
-                ++t.stats_.leaves;
-                t.stats_.references += n;
-                if (n == 0) ++t.stats_.empty_leaves;
+            Node& nd = t.nodes_[idx];
+            if (bn->axis >= 0) {
+                nd.split = bn->split;
+                nd.bits = uint32_t(bn->axis);
                 return;
             }
-            (*this)(*bn.child[0], depth + 1);
-            const uint32_t above = uint32_t(t.nodes_.size());
-            (*this)(*bn.child[1], depth + 1);
-            Node& nd = t.nodes_[idx];
-            nd.split = bn.split;
-            nd.bits = (above << 2) | uint32_t(bn.axis);
+            const size_t n = bn->prims.size();
+            uint32_t first = 0;
+            if (n == 1) {
+                first = slot_of(bn->prims[0]);
+            } else if (n > 1) {
+                first = uint32_t(t.refs_.size());
+                for (uint32_t p : bn->prims) t.refs_.push_back(slot_of(p));
+            }
+            t.nodes_[idx].first = first;
+            t.nodes_[idx].bits = (uint32_t(n) << 2) | 3u;
+            ++t.stats_.leaves;
+            t.stats_.references += n;
+            if (n == 0) ++t.stats_.empty_leaves;
+        }
+        struct Pair {
+            const BuildNode* parent;  // its two children form the pair
+            uint32_t parent_idx;
+            int depth;                // of the children
+        };
+        void run(const BuildNode& root) {
+            t.nodes_.emplace_back();
+            write(0, &root, 0);
+            if (root.axis < 0) return;
+            std::vector<Pair> work{{&root, 0, 1}};
+            Pair q[8];
+            while (!work.empty()) {
+                int qn = 0, qi = 0, placed = 0;
+                q[qn++] = work.back();
+                work.pop_back();
+                const size_t mark = work.size();
+                while (qi < qn) {
+                    const Pair p = q[qi++];
+                    if (placed == 4) {  // the treelet is full: the rest starts treelets of its own
+                        work.push_back(p);
+                        continue;
+                    }
+                    ++placed;
+                    const uint32_t c = uint32_t(t.nodes_.size());
+                    t.nodes_.emplace_back();
+                    t.nodes_.emplace_back();
+                    t.nodes_[p.parent_idx].bits |= c << 2;
+                    for (int k = 0; k < 2; ++k) {
+                        const BuildNode* ch = p.parent->child[k].get();
+                        write(c + uint32_t(k), ch, p.depth);
+                        if (ch->axis >= 0 && qn < 8) q[qn++] = {ch, c + uint32_t(k), p.depth + 1};
+                        else if (ch->axis >= 0) work.push_back({ch, c + uint32_t(k), p.depth + 1});
+                    }
+                }
+                // Depth first between treelets: the pairs just deferred are taken first, in order.
+                std::reverse(work.begin() + ptrdiff_t(mark), work.end());
+            }
         }
     };
-    Flatten{*this, mesh, list, std::vector<uint32_t>(list.size(), UINT32_MAX)}(*root, 0);
+    Flatten{*this, mesh, list, std::vector<uint32_t>(list.size(), UINT32_MAX)}.run(*root);
     nodes_.shrink_to_fit();
     tris_.shrink_to_fit();
     refs_.shrink_to_fit();
@@ -389,6 +426,7 @@ namespace {
 // Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
     float o[3], d[3], inv_d[3];
+    bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
     int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide edge test
     float sx, sy;
     explicit RayData(const Ray& ray) {
@@ -402,6 +440,7 @@ struct RayData {
             o[i] = ray.o[i];
             d[i] = ray.d[i];
             inv_d[i] = 1.f / ray.d[i];
+            d_nonpos[i] = ray.d[i] <= 0.f;
         }
     }
 };
@@ -454,6 +493,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     const RayShear sh(ray.d);
     float t0, t1;
     if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
+    t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
+    if (!(t0 <= t1)) return false;
 
     struct Todo {
         const Node* node;
@@ -474,23 +515,23 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             const float tp = (split - oa) * r.inv_d[a];
             // The sign of split - o is exact, so the child holding the origin is found without
             // rounding; a ray starting on the plane goes first to the side it moves into.
-            const bool below_first = oa < split || (oa == split && r.d[a] <= 0.f);
-            const Node* below = node + 1;
-            const Node* above = nodes + node->above();
+            const bool below_first = (oa < split) | ((oa == split) & r.d_nonpos[a]);
+            const Node* below = nodes + node->children();
+            const Node* above = below + 1;
             const Node* first = below_first ? below : above;
             const Node* second = below_first ? above : below;
             // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
             // for a ray lying in the plane, which then visits both children over the whole interval
-            // (std::max / std::min return their first argument for a NaN second).
-            if (tp > widen_up(t1) || tp <= 0.f) {
-                node = first;
-            } else if (tp < widen_down(t0)) {
-                node = second;
-            } else {
-                stack[sp++] = {second, std::max(t0, widen_down(tp)), t1};
-                node = first;
-                t1 = std::min(t1, widen_up(tp));
-            }
+            // (std::max / std::min return their first argument for a NaN second). Branch free: the
+            // three cases are data dependent and mispredict often on incoherent rays; the stack
+            // slot is written every time and kept only when both children are visited.
+            const bool only_first = (tp > t1 * kWidenUp) | (tp <= 0.f);
+            const bool only_second = !only_first & (tp < t0 * kWidenDown);
+            const bool both = !only_first & !only_second;
+            stack[sp] = {second, std::max(t0, tp * kWidenDown), t1};
+            sp += int(both);
+            t1 = both ? std::min(t1, tp * kWidenUp) : t1;
+            node = only_second ? second : first;
             continue;
         }
 
@@ -537,7 +578,7 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         for (;;) {
             if (sp == 0) return found;
             const Todo& td = stack[--sp];
-            if (Shadow || !(tmax < widen_down(td.t0))) {
+            if (Shadow || !(tmax < td.t0 * kWidenDown)) {
                 node = td.node;
                 t0 = td.t0;
                 t1 = td.t1;

@@ -63,8 +63,8 @@ public:
     size_t memory_bytes() const;
     const KdTreeStats& stats() const { return stats_; }
 
-    // Compact node: an interior node keeps the split position and the index of its second
-    // ("above") child (the first follows it directly). A leaf keeps its triangle count and
+    // Compact node: an interior node keeps the split position and the index of its first child
+    // ("below" the plane; the "above" child follows it: siblings are adjacent). A leaf keeps its triangle count and
     // `first`: the triangle's slot in tris_ itself when it holds one triangle (no indirection
     // for the commonest leaf), else the offset of its slot list in refs_.
     struct Node {
@@ -72,10 +72,10 @@ public:
             float split;
             uint32_t first;
         };
-        uint32_t bits;  // low 2 bits: axis 0-2, or 3 for a leaf; high 30: above child / count
+        uint32_t bits;  // low 2 bits: axis 0-2, or 3 for a leaf; high 30: children / count
         bool leaf() const { return (bits & 3u) == 3u; }
         int axis() const { return int(bits & 3u); }
-        uint32_t above() const { return bits >> 2; }
+        uint32_t children() const { return bits >> 2; }
         uint32_t count() const { return bits >> 2; }
     };
     static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
