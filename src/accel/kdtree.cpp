@@ -515,23 +515,25 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             const float tp = (split - oa) * r.inv_d[a];
             // The sign of split - o is exact, so the child holding the origin is found without
             // rounding; a ray starting on the plane goes first to the side it moves into.
-            const bool below_first = (oa < split) | ((oa == split) & r.d_nonpos[a]);
+            const bool below_first = oa < split || (oa == split && r.d_nonpos[a]);
             const Node* below = nodes + node->children();
             const Node* above = below + 1;
             const Node* first = below_first ? below : above;
             const Node* second = below_first ? above : below;
             // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
             // for a ray lying in the plane, which then visits both children over the whole interval
-            // (std::max / std::min return their first argument for a NaN second). Branch free: the
-            // three cases are data dependent and mispredict often on incoherent rays; the stack
-            // slot is written every time and kept only when both children are visited.
-            const bool only_first = (tp > t1 * kWidenUp) | (tp <= 0.f);
-            const bool only_second = !only_first & (tp < t0 * kWidenDown);
-            const bool both = !only_first & !only_second;
-            stack[sp] = {second, std::max(t0, tp * kWidenDown), t1};
-            sp += int(both);
-            t1 = both ? std::min(t1, tp * kWidenUp) : t1;
-            node = only_second ? second : first;
+            // (std::max / std::min return their first argument for a NaN second). Branches, not
+            // selects: a branch-free step measured the same on bounce rays and ~15% slower on
+            // (well predicted) primary rays.
+            if (tp > t1 * kWidenUp || tp <= 0.f) {
+                node = first;
+            } else if (tp < t0 * kWidenDown) {
+                node = second;
+            } else {
+                stack[sp++] = {second, std::max(t0, tp * kWidenDown), t1};
+                node = first;
+                t1 = std::min(t1, tp * kWidenUp);
+            }
             continue;
         }
 
