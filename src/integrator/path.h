@@ -16,7 +16,9 @@ struct PathStats {
 // Depth: `max_depth` counts scattering events (0: emitters seen directly, 1: direct lighting).
 // At a vertex reached after k scattering events, emission is added (a path of k events) and, when
 // k < max_depth, a light sample (a path of k + 1 events) and a BSDF sample for the next vertex.
-// Russian roulette starts once k >= rr_depth, with survival probability min(max(beta), 0.95).
+// Russian roulette starts once k >= rr_depth, with survival probability
+// min(max(beta) x prod(eta^2), 0.95): the eta^2 of refractions is undone so that paths inside glass
+// are not cut for a change of solid-angle measure (pbrt-v4 etaScale; Mitsuba does the same).
 class PathIntegrator {
 public:
     explicit PathIntegrator(const Scene& scene) : scene_(scene) {}
