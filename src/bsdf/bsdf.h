@@ -29,6 +29,25 @@ namespace candela {
 // docs/materials.md describes each model and its tests.
 using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf>;
 
+#if CANDELA_DIFFUSE_ONLY
+// The yardstick build for issue 6 (cmake -DCANDELA_DIFFUSE_ONLY=ON): the renderer's dispatch knows
+// only the diffuse BSDF, as a diffuse-only renderer would; any other BSDF renders black. It exists to
+// measure what the full variant costs a diffuse scene (docs/accuracy.md); not for real use.
+inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+    return d ? d->eval(wo, wi, mode) : vec3(0.f);
+}
+inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+    return d ? d->pdf(wo, wi, mode) : 0.f;
+}
+inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2,
+                                        TransportMode mode = TransportMode::Radiance) {
+    const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+    return d ? d->sample(wo, u1, u2, mode) : std::nullopt;
+}
+inline bool has_smooth_component(const Bsdf& b) { return std::holds_alternative<DiffuseBsdf>(b); }
+#else
 inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     return std::visit([&](const auto& x) { return x.eval(wo, wi, mode); }, b);
 }
@@ -43,6 +62,7 @@ inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u
 inline bool has_smooth_component(const Bsdf& b) {
     return std::visit([](const auto& x) { return x.has_smooth_component(); }, b);
 }
+#endif
 
 // Derives what a BSDF precomputes from its parameters (the plastic coat's tables). Call it after
 // creating or editing a BSDF; it is cheap when nothing changed.
