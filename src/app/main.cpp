@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
     app.add_option("--out", opt.out, "Write the image and exit: .png (sRGB through the display shaders), .exr or .pfm (linear)");
     auto* w_opt = app.add_option("--width", width, "Image width in pixels (overrides the scene)");
     auto* h_opt = app.add_option("--height", height, "Image height in pixels (overrides the scene)");
-    auto* d_opt = app.add_option("--max-depth", max_depth, "Scattering events per path: 0 emitters only, 1 direct light, -1 unbounded");
+    auto* d_opt = app.add_option("--max-depth", max_depth, "Scattering events per path: 0 emitters only, 1 direct light, -1 unbounded (default).\n"
+                                                       "A finite depth is biased: it drops longer paths");
     auto* r_opt = app.add_option("--rr-depth", rr_depth, "Scattering events before Russian roulette starts");
     auto* s_opt = app.add_option("--seed", seed, "Sampler seed (overrides the scene)");
     app.add_option("--threads", opt.threads, "Render threads (default: all cores)")->check(CLI::Range(0, 1024));

@@ -505,7 +505,11 @@ void Viewer::panel() {
             st.max_depth = std::max(-1, st.max_depth);
             params_changed();
         }
-        if (ImGui::IsItemHovered()) ImGui::SetTooltip("Scattering events per path; -1: unbounded");
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Scattering events per path; -1: unbounded (unbiased, ended by Russian roulette)");
+        // A finite depth drops every longer path: the image converges to a darker one. Say so
+        // where the setting is made (docs/accuracy.md measures the energy lost per depth).
+        if (st.max_depth >= 0) ImGui::TextColored(ImVec4(1.f, 0.75f, 0.3f, 1.f), "biased: paths longer than %d are dropped", st.max_depth);
         if (ImGui::InputInt("RR depth", &st.rr_depth)) {
             st.rr_depth = std::max(0, st.rr_depth);
             params_changed();
