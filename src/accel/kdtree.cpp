@@ -429,8 +429,7 @@ struct RayData {
     bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
     int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide edge test
     float sx, sy;
-    explicit RayData(const Ray& ray) {
-        const RayShear sh(ray.d);
+    RayData(const Ray& ray, const RayShear& sh) {
         kx = sh.kx;
         ky = sh.ky;
         kz = sh.kz;
@@ -489,8 +488,8 @@ template <bool Shadow>
 bool KdTree::trace(Ray& ray, Hit* hit) const {
     if (nodes_.empty()) return false;
     KD_COUNT(rays, 1);
-    const RayData r(ray);
     const RayShear sh(ray.d);
+    const RayData r(ray, sh);
     float t0, t1;
     if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
     t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
