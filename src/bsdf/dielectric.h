@@ -21,9 +21,12 @@ namespace candela {
 //                 refraction   f |cos theta_i| = T_s (1 - F) D G eta_r^2 |wo.h| |wi.h|
 //                                                / (|cos theta_o| (wo.h + eta_r wi.h)^2) * s
 //               with s = 1 / eta_r^2 in Radiance mode and 1 in Importance mode, F = F(wo.h).
-//               Sampling picks h from the normals visible from wo (flipped to the upper side),
-//               then reflects with probability F and refracts otherwise:
-//                 pdf = F D_wo(h) / (4 |wi.h|)   or   (1 - F) D_wo(h) eta_r^2 |wi.h| / (wo.h + eta_r wi.h)^2.
+//               Sampling picks h from the normals visible from wo (Heitz 2018; from inside, from
+//               those visible from -wo), then reflects with probability F and refracts otherwise:
+//                 pdf = F D_wo(h) / (4 |wo.h|)   or   (1 - F) D_wo(h) eta_r^2 |wi.h| / (wo.h + eta_r wi.h)^2
+//               with D_wo(h) = G1(wo, h) |wo.h| D(h) / |cos theta_o|. The sample weight is then
+//               R_s G1(wi, h) (reflection) or T_s G1(wi, h) s (refraction): at most 1, or 1 / eta_r^2
+//               for Radiance leaving the denser side, whatever the roughness and angle.
 //
 // Radiance mode follows the radiance from wi to wo, which is squeezed into a smaller solid angle
 // on entering a denser medium: L grows by eta_r^2 (n_o / n_i)^2 going in. Importance flows the
@@ -68,22 +71,34 @@ struct DielectricBsdf {
             }
             return s.pdf > 0.f ? std::optional<BsdfSample>(s) : std::nullopt;
         }
+        // m from the normals visible from wo; from inside (wo.z < 0) from those visible from the
+        // mirrored wo, as Mitsuba 3 does, so that m is on the upper side like eval_pdf's h.
         const Ggx ggx(alpha);
         const float side = wo.z > 0.f ? 1.f : -1.f;
-        const vec3 m = ggx.sample_visible(wo * side, u2);  // on the upper side, facing wo
-        const FresnelDielectric fr = fresnel_dielectric(glm::dot(wo, m), e);
+        const vec3 m = ggx.sample_visible(wo * side, u2);
+        const float om = glm::dot(wo, m);
+        const FresnelDielectric fr = fresnel_dielectric(om, e);
+        const float dm = ggx.pdf_visible(wo * side, m);  // D_wo(m)
+        // f and pdf come from m itself, not from the half vector eval_pdf rebuilds out of wo and wi:
+        // near grazing reflection wo + wi nearly cancels, and the rebuilt h (so D, G1 and the
+        // Jacobian) can be far off m, giving weights of 1e4 and more at alpha 1e-4. From m the
+        // weight is exactly R G1(wi, m), or T G1(wi, m) / eta_r^2 in Radiance mode.
+        float g1i;
         if (u1 < fr.F) {
             s.wi = reflect(wo, m);
-            if (s.wi.z * wo.z <= 0.f) return std::nullopt;
+            g1i = ggx.G1(s.wi, m);  // zero unless wi is on wo's side and sees m
+            s.pdf = fr.F * dm / (4.f * std::abs(om));
+            s.f = specular_reflectance * (g1i * s.pdf);
         } else {
             s.wi = glm::normalize(refract(wo, m, fr.cos_t, fr.eta_ti));
-            if (s.wi.z * wo.z >= 0.f) return std::nullopt;
-            s.eta = fr.eta_it;
+            g1i = ggx.G1(s.wi, m);  // zero unless wi is on the other side and sees m
+            const float eta_r = fr.eta_it, im = glm::dot(s.wi, m), denom = om + eta_r * im;
+            s.pdf = (1.f - fr.F) * dm * eta_r * eta_r * std::abs(im) / (denom * denom);
+            const float scale = mode == TransportMode::Radiance ? 1.f / (eta_r * eta_r) : 1.f;
+            s.f = specular_transmittance * (g1i * scale * s.pdf);
+            s.eta = eta_r;
         }
-        const Rough r = eval_pdf(wo, s.wi, mode);
-        if (!(r.pdf > 0.f)) return std::nullopt;
-        s.f = r.f;
-        s.pdf = r.pdf;
+        if (!(g1i > 0.f) || !(s.pdf > 0.f) || !std::isfinite(s.pdf) || !all_finite(s.f)) return std::nullopt;
         return s;
     }
     bool has_smooth_component() const { return !is_delta(); }
@@ -116,8 +131,10 @@ private:
         // Density of h: visible normals from wo flipped to the upper side.
         const float dv = ggx.G1(wo * (co > 0.f ? 1.f : -1.f), h) * std::abs(oh) * D / std::abs(co);
         if (reflection) {
+            // The Jacobian 1 / (4 |wi.h|) written with |wo.h| (equal for a true half vector), so
+            // that f / pdf is R G1(wi, h) even where rounding makes h inexact (grazing angles).
             r.f = specular_reflectance * (F * D * G / (4.f * std::abs(co)));
-            r.pdf = F * dv / (4.f * std::abs(ih));
+            r.pdf = F * dv / (4.f * std::abs(oh));
         } else {
             const float denom = oh + eta_r * ih;
             const float denom2 = denom * denom;

@@ -136,15 +136,22 @@ vec3 PlasticBsdf::diffuse_value(vec3 wo, vec3 wi) const {
     return base * (to * ti * wi.z * kInvPi / (e * e));
 }
 
+PlasticBsdf::Lobe PlasticBsdf::coat(vec3 wo, vec3 wi, vec3 m) const {
+    const Ggx ggx(alpha);
+    const float g1o = ggx.G1(wo, m), g1i = ggx.G1(wi, m);
+    if (g1o == 0.f || g1i == 0.f) return {};
+    // pdf = D_wo(m) / (4 wo.m) = G1(wo, m) D(m) / (4 cos theta_o): the Jacobian of reflection,
+    // 1 / (4 wi.m), written with wo.m (equal for a half vector) so that f / pdf is
+    // R F G1(wi, m) <= R even where rounding makes m an inexact half vector of wo and wi.
+    const float pdf = g1o * ggx.D(m) / (4.f * wo.z);
+    const float F = fresnel_dielectric(glm::dot(wo, m), eta()).F;
+    return {specular_reflectance * (F * g1i * pdf), pdf};
+}
+
 vec3 PlasticBsdf::eval(vec3 wo, vec3 wi, TransportMode) const {
     if (wo.z <= 0.f || wi.z <= 0.f || !prepared()) return vec3(0.f);
     vec3 f = diffuse_value(wo, wi);
-    if (!smooth()) {
-        const vec3 h = glm::normalize(wo + wi);
-        const Ggx ggx(alpha);
-        const float F = fresnel_dielectric(glm::dot(wo, h), eta()).F;
-        f += specular_reflectance * (F * ggx.D(h) * ggx.G(wo, wi, h) / (4.f * wo.z));
-    }
+    if (!smooth()) f += coat(wo, wi, glm::normalize(wo + wi)).f;
     return f;
 }
 
@@ -152,11 +159,7 @@ float PlasticBsdf::pdf(vec3 wo, vec3 wi, TransportMode) const {
     if (wo.z <= 0.f || wi.z <= 0.f || !prepared()) return 0.f;
     const float ps = specular_probability(wo.z);
     float p = (1.f - ps) * square_to_cosine_hemisphere_pdf(wi);
-    if (!smooth()) {
-        const vec3 h = glm::normalize(wo + wi);
-        const Ggx ggx(alpha);
-        p += ps * ggx.pdf_visible(wo, h) / (4.f * glm::dot(wi, h));
-    }
+    if (!smooth()) p += ps * coat(wo, wi, glm::normalize(wo + wi)).pdf;
     return p;
 }
 
@@ -172,14 +175,21 @@ std::optional<BsdfSample> PlasticBsdf::sample(vec3 wo, float u1, vec2 u2, Transp
         return s;
     }
     if (u1 < ps) {
-        s.wi = reflect(wo, Ggx(alpha).sample_visible(wo, u2));
+        // The coat's part from the sampled normal m itself: near grazing, the half vector that
+        // eval() rebuilds from wo + wi (nearly cancelling) can be far from m.
+        const vec3 m = Ggx(alpha).sample_visible(wo, u2);
+        s.wi = reflect(wo, m);
+        if (s.wi.z <= 0.f) return std::nullopt;
+        const Lobe c = coat(wo, s.wi, m);
+        s.f = c.f + diffuse_value(wo, s.wi);
+        s.pdf = ps * c.pdf + (1.f - ps) * square_to_cosine_hemisphere_pdf(s.wi);
     } else {
         s.wi = square_to_cosine_hemisphere(u2);
+        if (s.wi.z <= 0.f) return std::nullopt;
+        s.f = eval(wo, s.wi, mode);
+        s.pdf = pdf(wo, s.wi, mode);
     }
-    if (s.wi.z <= 0.f) return std::nullopt;
-    s.f = eval(wo, s.wi, mode);
-    s.pdf = pdf(wo, s.wi, mode);
-    if (!(s.pdf > 0.f)) return std::nullopt;
+    if (!(s.pdf > 0.f) || !std::isfinite(s.pdf) || !all_finite(s.f)) return std::nullopt;
     return s;
 }
 

@@ -26,7 +26,8 @@ struct CoatTables {
 // false by default). eta = int_ior / ext_ior. With T(mu) the coat's transmittance, Ri its internal
 // reflectance and rho = diffuse_reflectance:
 //   specular  alpha == 0: a delta mirror lobe with weight R_s F(cos theta_o), eval/pdf exclude it.
-//             alpha > 0:  GGX reflection R_s F(wo.h) D G / (4 cos theta_o) (as the rough conductor)
+//             alpha > 0:  GGX reflection R_s F(wo.h) D G / (4 cos theta_o) (as the rough conductor),
+//                         h sampled from the visible normals: lobe weight R_s F(wo.h) G1(wi, h) <= 1
 //   diffuse   f cos theta_i = rho / (1 - Ri) * T(cos theta_o) T(cos theta_i) cos theta_i / (pi eta^2)
 //             (nonlinear: rho / (1 - rho Ri), the colour shift of repeated internal bounces)
 // T and Ri are Mitsuba's: smooth T = 1 - F, Ri = the hemispherical average of F from inside; rough
@@ -56,6 +57,13 @@ struct PlasticBsdf {
     bool has_smooth_component() const { return true; }
 
 private:
+    struct Lobe {
+        vec3 f{0.f};      // f |cos theta_i|
+        float pdf = 0.f;  // the lobe's own density (before the lobe choice)
+    };
+    // The rough coat's GGX reflection from wo to wi through the microfacet normal m (their half
+    // vector); the lobe samples m from the normals visible from wo (Heitz 2018).
+    Lobe coat(vec3 wo, vec3 wi, vec3 m) const;
     float specular_probability(float cos_o) const;
     vec3 diffuse_value(vec3 wo, vec3 wi) const;
 };
