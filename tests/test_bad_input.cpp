@@ -177,9 +177,9 @@ TEST(BadInput, CommandLineValues) {
     // Usage errors (a value of the wrong type or out of range) exit 2, as CLI11 parse errors do.
     expect_clean_error(run_candela("--width abc --out " + d + "/x.exr"), {"--width"}, 2);
     expect_clean_error(run_candela("--frames 0 --out " + d + "/x.exr"), {"--frames"}, 2);
-    // An output that cannot be written is reported after the render, with the file's name.
+    // An output that cannot be written is refused before rendering, not after.
     expect_clean_error(run_candela("--width 8 --height 8 --frames 1 --quiet --out /nonexistent/dir/x.exr"),
-                       {"/nonexistent/dir/x.exr"});
+                       {"/nonexistent/dir/x.exr: directory '/nonexistent/dir' does not exist"});
     // The size check runs on the scene file's resolution too, before any film is allocated.
     write_text(d + "/big.xml", xml("<sensor type=\"perspective\"><film type=\"hdrfilm\">\n"
                                    "<integer name=\"width\" value=\"1000000\"/><integer name=\"height\" "

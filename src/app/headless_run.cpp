@@ -5,6 +5,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include "app/checkpoint.h"
 #include "core/error.h"
@@ -43,6 +44,15 @@ void install_signal_handlers() {
     sigaction(SIGTERM, &sa, nullptr);
 }
 
+// Refuses an output whose directory is missing or not writable before rendering, not hours later.
+void check_writable(const std::string& path) {
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec)) throw Error(path, 0, "directory '" + dir + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0) throw Error(path, 0, "cannot write in directory '" + dir + "'");
+}
+
 void progress_bar(uint64_t done, uint64_t total, double secs, double msps) {
     const int width = 30;
     int filled = total > 0 ? int(double(width) * double(done) / double(total)) : 0;
@@ -60,6 +70,8 @@ int run_headless(const HeadlessOptions& opt) {
     std::string ext = file_extension(opt.out);
     if (ext != ".png" && ext != ".exr" && ext != ".pfm")
         throw Error(opt.out, 0, "unknown output format '" + ext + "' (expected .png, .exr or .pfm)");
+    check_writable(opt.out);
+    if (!opt.checkpoint.empty()) check_writable(opt.checkpoint);
 
     // Handlers go in before the (possibly long) scene load, so that no signal finds the default
     // action (death without an image) once candela has started.
