@@ -186,3 +186,21 @@ TEST(BadInput, CommandLineValues) {
                                    "value=\"1000000\"/></film></sensor>\n<shape type=\"cube\"/>\n"));
     expect_clean_error(run_candela(d + "/big.xml --quiet --out " + d + "/x.exr"), {d + "/big.xml", "GB"});
 }
+
+TEST(BadInput, CyclicRefsAndDeepNesting) {
+    // Both used to overflow the stack (a crash): refs resolve recursively through wrappers.
+    std::string d = temp_dir("bad-cycle");
+    write_text(d + "/self.xml", xml("<bsdf type=\"twosided\" id=\"a\">\n<ref id=\"a\"/></bsdf>\n"
+                                    "<shape type=\"cube\"><ref id=\"a\"/></shape>\n"));
+    expect_clean_error(render(d + "/self.xml", d), {d + "/self.xml:3: cyclic reference: bsdf 'a' (line 2)"});
+    write_text(d + "/pair.xml", xml("<bsdf type=\"twosided\" id=\"a\"><ref id=\"b\"/></bsdf>\n"
+                                    "<bsdf type=\"twosided\" id=\"b\">\n<ref id=\"a\"/></bsdf>\n"));
+    expect_clean_error(render(d + "/pair.xml", d), {d + "/pair.xml:4: cyclic reference: bsdf 'a' (line 2)"});
+    std::string open, close;
+    for (int i = 0; i < 20000; ++i) {
+        open += "<bsdf type=\"twosided\">";
+        close += "</bsdf>";
+    }
+    write_text(d + "/deep.xml", xml("<shape type=\"cube\">" + open + "<bsdf type=\"diffuse\"/>" + close + "</shape>\n"));
+    expect_clean_error(render(d + "/deep.xml", d), {d + "/deep.xml:2: bsdfs nested more than 64 deep"});
+}

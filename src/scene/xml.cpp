@@ -167,6 +167,10 @@ private:
         int material = -1;  // bsdfs: the material once created
     };
     std::map<std::string, IdEntry> ids_;
+    // The bsdfs being built, outermost first: wrappers (twosided) recurse through nested bsdfs and
+    // refs, so a ref cycle or a deep nest must be an error before it is a stack overflow.
+    std::vector<pugi::xml_node> bsdf_stack_;
+    static constexpr size_t kMaxBsdfNesting = 64;
     Scene scene_;
     int shape_counter_ = 0;
 };
@@ -624,6 +628,13 @@ Material XmlLoader::nested_bsdf(Object& wrapper) {
 }
 
 uint32_t XmlLoader::load_bsdf(pugi::xml_node n, const std::string& fallback_name) {
+    if (bsdf_stack_.size() >= kMaxBsdfNesting)
+        throw error(n, "bsdfs nested more than " + std::to_string(kMaxBsdfNesting) + " deep");
+    bsdf_stack_.push_back(n);
+    struct Pop {
+        std::vector<pugi::xml_node>& stack;
+        ~Pop() { stack.pop_back(); }
+    } pop{bsdf_stack_};
     Object o = read_object(n, "bsdf");
     BsdfFactory make = nullptr;
     for (const auto& p : kBsdfPlugins)
@@ -646,6 +657,8 @@ uint32_t XmlLoader::bsdf_by_id(pugi::xml_node ref_node, const std::string& id) {
     IdEntry& e = it->second;
     if (e.tag != "bsdf")
         throw error(ref_node, "id '" + id + "' is a <" + e.tag + "> (line " + std::to_string(e.line) + "), not a <bsdf>");
+    if (e.material < 0 && std::find(bsdf_stack_.begin(), bsdf_stack_.end(), e.node) != bsdf_stack_.end())
+        throw error(ref_node, "cyclic reference: bsdf '" + id + "' (line " + std::to_string(e.line) + ") contains itself");
     if (e.material < 0) e.material = int(load_bsdf(e.node, id));  // referenced before its definition
     return uint32_t(e.material);
 }
