@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages candela needs. Idempotent: when everything is present it only
 # queries dpkg and returns; it runs `apt-get update` only when something is missing.
-# Usage: bash scripts/setup.sh [--with-embree]
+# Usage: bash scripts/setup.sh [--with-embree] [--with-fuzz]   (--with-fuzz: clang and libFuzzer for scripts/fuzz.sh)
 set -euo pipefail
 pkgs=(
   cmake ninja-build g++ pkg-config
@@ -13,6 +13,7 @@ pkgs=(
 for a in "$@"; do
   case "$a" in
     --with-embree) pkgs+=(libembree-dev) ;;
+    --with-fuzz) pkgs+=(clang-14 libclang-rt-14-dev) ;;
     *) echo "setup.sh: unknown option '$a'" >&2; exit 2 ;;
   esac
 done
