@@ -1,9 +1,42 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test under ctest.
-# Usage: bash scripts/test.sh [--sanitize]   (--sanitize: the ASan+UBSan build in build-asan/)
+# Installs what is missing, builds, and runs the tests under ctest.
+# Usage: bash scripts/test.sh [--sanitize | --tsan]
+#   (none)      the Release build in build/, every test
+#   --sanitize  the ASan+UBSan build in build-asan/, every test but the statistical ones listed in
+#               CANDELA_ASAN_EXCLUDE (their code runs under ASan in the other tests; see
+#               docs/reliability.md). CANDELA_ASAN_EXCLUDE= (empty) runs them all.
+#   --tsan      a ThreadSanitizer build in build-tsan/, the render session tests (Session.*), with
+#               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
+#               cannot see its barriers; one OpenMP thread per pass leaves TSan the session's own
+#               threads (worker and front end) to check. See docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/setup.sh
-dir=$(bash scripts/build.sh "$@" | tail -n 1)
-cd "$dir"
-ctest --output-on-failure -j"$(nproc)" --timeout 600
+mode=${1:-}
+case "$mode" in
+  "")
+    dir=$(bash scripts/build.sh | tail -n 1)
+    cd "$dir"
+    ctest --output-on-failure -j"$(nproc)" --timeout 600
+    ;;
+  --sanitize)
+    dir=$(bash scripts/build.sh --sanitize | tail -n 1)
+    cd "$dir"
+    # Leaks are errors; any sanitizer report fails the test (and shows its stack).
+    export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1}
+    export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+    export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/../tests/lsan.supp}  # Mesa's own leaks
+    exclude=${CANDELA_ASAN_EXCLUDE-'^(BsdfChi2|BsdfModels|Furnace|ImageCornell|Mis|BsdfScenes|WarpChi2|LightSet)\.'}
+    ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
+    ;;
+  --tsan)
+    if [ ! -f build-tsan/build.ninja ]; then
+      cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCANDELA_VIEWER=OFF -DCANDELA_BENCH=OFF \
+        -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" >/dev/null
+    fi
+    cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2
+    export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp"
+    OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*'
+    ;;
+  *) echo "test.sh: unknown option '$mode'" >&2; exit 2 ;;
+esac

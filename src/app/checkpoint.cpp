@@ -23,6 +23,7 @@ namespace {
 class Hasher {
 public:
     void bytes(const void* data, size_t n) {
+        if (n == 0) return;  // an empty vector's data() may be null, which memcpy must not see
         const unsigned char* p = static_cast<const unsigned char*>(data);
         length_ += n;
         if (fill_ > 0) {  // complete the word left over from the last call
