@@ -2,9 +2,9 @@
 # Installs what is missing, builds, and runs the tests under ctest.
 # Usage: bash scripts/test.sh [--sanitize | --tsan]
 #   (none)      the Release build in build/, every test
-#   --sanitize  the ASan+UBSan build in build-asan/, every test but the statistical ones listed in
-#               CANDELA_ASAN_EXCLUDE (their code runs under ASan in the other tests; see
-#               docs/reliability.md). CANDELA_ASAN_EXCLUDE= (empty) runs them all.
+#   --sanitize  the ASan+UBSan build in build-asan/, every test (about 7x the Release suite's CPU
+#               time, see docs/reliability.md); CANDELA_ASAN_EXCLUDE=REGEX leaves tests out
+#               (ctest -E), e.g. '^(BsdfChi2|ImageCornell|KdTree)\.' for a quick local run
 #   --tsan      a ThreadSanitizer build in build-tsan/, the render session tests (Session.*), with
 #               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
 #               cannot see its barriers; one OpenMP thread per pass leaves TSan the session's own
@@ -25,9 +25,14 @@ case "$mode" in
     # Leaks are errors; any sanitizer report fails the test (and shows its stack).
     export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1}
     export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-    export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/../tests/lsan.supp}  # Mesa's own leaks
-    exclude=${CANDELA_ASAN_EXCLUDE-'^(BsdfChi2|BsdfModels|Furnace|ImageCornell|Mis|BsdfScenes|WarpChi2|LightSet)\.'}
-    ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
+    export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/../tests/lsan.supp:print_suppressions=0}  # Mesa's own leaks
+    # The viewer window test leaks inside Mesa's GL driver, which is unloaded (dlclose) before
+    # LeakSanitizer runs, so no suppression can name it: it runs with leak checking off (memory
+    # errors and UB are still fatal).
+    viewer='^ViewerWindow\.'
+    exclude=${CANDELA_ASAN_EXCLUDE:-}
+    ctest --output-on-failure -j"$(nproc)" --timeout 1800 -E "${exclude:+$exclude|}$viewer"
+    ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --output-on-failure --timeout 1800 -R "$viewer"
     ;;
   --tsan)
     if [ ! -f build-tsan/build.ninja ]; then
