@@ -375,8 +375,9 @@ TEST(SceneXml, Errors) {
     expect_error("<shape type=\"rectangle\">\n<foo/></shape>\n", 3, "unknown tag <foo>");
     expect_error("\n<bar/>\n", 3, "unknown tag <bar>");
     expect_error("<shape type=\"sphere\"/>\n", 2, "unsupported shape type 'sphere'");
-    expect_error("\n<bsdf type=\"conductor\" id=\"c\"/>\n", 3, "unsupported bsdf type 'conductor'");
-    expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "unsupported bsdf type 'twosided'");
+    expect_error("\n<bsdf type=\"blendbsdf\" id=\"c\"/>\n", 3, "unsupported bsdf type 'blendbsdf'");
+    expect_error("<shape type=\"rectangle\">\n<bsdf type=\"measured\"/></shape>\n", 3, "unsupported bsdf type 'measured'");
+    expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "needs a nested <bsdf>");
     expect_error("<integrator type=\"volpath\"/>\n", 2, "unsupported integrator type 'volpath'");
     expect_error("<emitter type=\"constant\"/>\n", 2, "unsupported emitter type 'constant'");
     expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\">\n<rfilter type=\"gaussian\"/></film></sensor>\n", 4,
