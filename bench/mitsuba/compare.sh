@@ -34,9 +34,11 @@ c_sps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Msamples\/s.*/\1/p')
 c_rps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Mrays\/s.*/\1/p')
 echo "candela:            $c_sps Msamples/s ($c_rps Mrays/s)"
 for variant in scalar_rgb llvm_ad_rgb; do
-  log=$("$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant $variant --spp "$spp" --threads "$threads" \
-        --warmup --out "$out/mitsuba_$variant.exr" 2>&1)
-  sps=$(echo "$log" | grep -o '[0-9.e+]* samples/s' | tail -n 1 | awk '{printf "%.3f", $1 / 1e6}')
+  "$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant $variant --spp "$spp" --threads "$threads" \
+        --warmup --out "$out/mitsuba_$variant.exr" > "$out/mitsuba_$variant.log" 2>&1
+  # The tool writes its timings next to the image as JSON (samples_per_s excludes load and warm-up).
+  sps=$("$PY" -c 'import json, sys; print("%.3f" % (json.load(open(sys.argv[1]))["samples_per_s"] / 1e6))' \
+        "$out/mitsuba_$variant.json")
   echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(awk -v a="$c_sps" -v b="$sps" 'BEGIN{printf "%.2f", a / b}')"
 done
 echo "--- imgcmp candela vs mitsuba llvm_ad_rgb (same spp) ---"
