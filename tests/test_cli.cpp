@@ -95,4 +95,7 @@ TEST(Cli, SummaryLineWhenNotATerminal) {
     EXPECT_NE(r.output.find("Msamples/s"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("Mrays/s"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("3 spp"), std::string::npos) << r.output;
+    // The memory report of the built-in box (32 triangles, lights present, no vertex normals).
+    EXPECT_NE(r.output.find("candela: 32 triangles,"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("B/triangle: mesh "), std::string::npos) << r.output;
 }

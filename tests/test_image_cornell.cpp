@@ -5,8 +5,8 @@
 // Mitsuba 3.9.1 llvm_ad_rgb renders of 4096 spp each at 64 x 64, unbounded depth, box filter, and
 // the per-pixel variance of that mean from the spread of the 16 batches; tests/data/make_reference.py
 // made it:
-//   $PY tests/data/make_reference.py scenes/cornell-box/scene.xml --res 64 --batches 16 --spp 4096 \
-//       --out tests/data/cornell64
+//   $PY tests/data/make_reference.py scenes/cornell-box/scene.xml --res 64 --batches 16 --spp 4096
+//       --out tests/data/cornell64     (one command)
 // candela renders 8 batches of 64 spp with different seeds; its variance comes from the batch
 // spread too. Two checks: a block z-test (8 x 8 blocks, Sidak-corrected over blocks and channels)
 // for local errors, and a whole-image z-test per channel for small global biases that no single

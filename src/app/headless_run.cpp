@@ -153,6 +153,13 @@ int run_headless(const HeadlessOptions& opt) {
     const int sig = g_signal.load();
     if (!opt.quiet) {
         double spp = double(film.total_samples()) / (double(film.width()) * film.height());
+        // Memory first: scripts read the summary from the last line.
+        const Scene::Memory mem = scene.memory();
+        const double per_tri = mem.triangles ? 1.0 / double(mem.triangles) : 0.0;
+        std::fprintf(stderr,
+                     "candela: %zu triangles, %.1f MB (%.1f B/triangle: mesh %.1f, accel %.1f, lights %.1f)\n",
+                     mem.triangles, double(mem.total()) / 1e6, double(mem.total()) * per_tri,
+                     double(mem.mesh) * per_tri, double(mem.accel) * per_tri, double(mem.lights) * per_tri);
         std::fprintf(stderr,
                      "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",

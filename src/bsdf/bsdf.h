@@ -64,6 +64,47 @@ inline bool has_smooth_component(const Bsdf& b) {
 }
 #endif
 
+// Dispatch chosen per scene (render/renderer.cpp): when every material of a scene is diffuse, the
+// renderer instantiates the path tracer with DiffuseOnly = true, and these compile to the very code
+// of the diffuse-only build above -- no variant dispatch, no code for the other lobes in the loop.
+// A non-diffuse BSDF never reaches the DiffuseOnly instantiation; if one did, it would render black.
+template <bool DiffuseOnly>
+inline vec3 eval_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    if constexpr (DiffuseOnly) {
+        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+        return d ? d->eval(wo, wi, mode) : vec3(0.f);
+    } else {
+        return eval(b, wo, wi, mode);
+    }
+}
+template <bool DiffuseOnly>
+inline float pdf_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    if constexpr (DiffuseOnly) {
+        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+        return d ? d->pdf(wo, wi, mode) : 0.f;
+    } else {
+        return pdf(b, wo, wi, mode);
+    }
+}
+template <bool DiffuseOnly>
+inline std::optional<BsdfSample> sample_in(const Bsdf& b, vec3 wo, float u1, vec2 u2,
+                                           TransportMode mode = TransportMode::Radiance) {
+    if constexpr (DiffuseOnly) {
+        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+        return d ? d->sample(wo, u1, u2, mode) : std::nullopt;
+    } else {
+        return sample(b, wo, u1, u2, mode);
+    }
+}
+template <bool DiffuseOnly>
+inline bool has_smooth_component_in(const Bsdf& b) {
+    if constexpr (DiffuseOnly) {
+        return std::holds_alternative<DiffuseBsdf>(b);
+    } else {
+        return has_smooth_component(b);
+    }
+}
+
 // Derives what a BSDF precomputes from its parameters (the plastic coat's tables). Call it after
 // creating or editing a BSDF; it is cheap when nothing changed.
 inline void prepare(Bsdf& b) {

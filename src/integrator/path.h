@@ -25,12 +25,23 @@ public:
 
     // Radiance arriving along the camera ray (towards -ray.d). Template on the sampler so that the
     // independent sampler's calls are inlined; MLT instantiates it with its own sampler.
-    template <class S>
+    // DiffuseOnly: the caller has checked that every material is diffuse (scene_is_diffuse_only);
+    // BSDF calls then skip the variant dispatch and the code of the other lobes (issue 6: a feature a
+    // scene does not use costs it nothing).
+    template <class S, bool DiffuseOnly = false>
     vec3 Li(Ray ray, S& sampler, PathStats& stats) const;
 
 private:
     const Scene& scene_;
 };
+
+// True when every material of the scene is the diffuse BSDF, so that PathIntegrator::Li can be
+// instantiated with DiffuseOnly = true.
+inline bool scene_is_diffuse_only(const Scene& scene) {
+    for (const Material& m : scene.materials)
+        if (!std::holds_alternative<DiffuseBsdf>(m.bsdf)) return false;
+    return true;
+}
 
 }  // namespace candela
 

@@ -45,6 +45,14 @@ public:
     // The emitter of the shape a triangle belongs to, or -1.
     int32_t emitter_of(uint32_t prim) const { return prim_light_.empty() ? -1 : tri_emitter_[prim]; }
 
+    // Bytes held by the light tables (the per-triangle maps exist only when the scene has lights).
+    size_t memory_bytes() const {
+        return tris_.capacity() * sizeof(uint32_t) + area_.capacity() * sizeof(float) +
+               radiance_.capacity() * sizeof(vec3) + prim_light_.capacity() * sizeof(int32_t) +
+               tri_emitter_.capacity() * sizeof(int32_t) + emitter_radiance_.capacity() * sizeof(vec3) +
+               dist_.memory_bytes();
+    }
+
 private:
     const Mesh* mesh_ = nullptr;
     std::vector<uint32_t> tris_;          // emissive triangle ids

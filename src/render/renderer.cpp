@@ -4,13 +4,16 @@
 
 namespace candela {
 
-PassStats Renderer::render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
-                                const std::atomic<bool>* cancel) {
+namespace {
+
+// One pass over all tiles with the path tracer instantiated for the scene's features.
+template <bool DiffuseOnly>
+PassStats run_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
+                   const std::atomic<bool>* cancel) {
     const int w = film.width(), h = film.height();
-    const int tiles_x = (w + kTileSize - 1) / kTileSize;
-    const int tiles_y = (h + kTileSize - 1) / kTileSize;
+    const int tiles_x = (w + Renderer::kTileSize - 1) / Renderer::kTileSize;
+    const int tiles_y = (h + Renderer::kTileSize - 1) / Renderer::kTileSize;
     const int n_tiles = tiles_x * tiles_y;
-    const int n_threads = threads > 0 ? threads : omp_get_max_threads();
     PathIntegrator integrator(scene);
     std::atomic<uint64_t> total_rays{0}, total_samples{0};
     std::atomic<bool> stopped{false};
@@ -25,15 +28,15 @@ PassStats Renderer::render_pass(const Scene& scene, Film& film, uint32_t first_s
         IndependentSampler sampler(scene.settings.seed);
         PathStats ps;
         uint64_t samples = 0;
-        const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-        const int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
+        const int x0 = (tile % tiles_x) * Renderer::kTileSize, y0 = (tile / tiles_x) * Renderer::kTileSize;
+        const int x1 = std::min(x0 + Renderer::kTileSize, w), y1 = std::min(y0 + Renderer::kTileSize, h);
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
                 for (int s = 0; s < spp; ++s) {
                     sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
                     vec2 jitter = sampler.next_2d();  // box filter: uniform over the pixel
                     Ray ray = scene.camera.generate_ray(vec2(float(x), float(y)) + jitter);
-                    vec3 L = integrator.Li(ray, sampler, ps);
+                    vec3 L = integrator.template Li<IndependentSampler, DiffuseOnly>(ray, sampler, ps);
                     film.add_sample(ivec2(x, y), L);
                     ++samples;
                 }
@@ -46,6 +49,17 @@ PassStats Renderer::render_pass(const Scene& scene, Film& film, uint32_t first_s
     out.samples = total_samples.load();
     out.completed = !stopped.load();
     return out;
+}
+
+}  // namespace
+
+PassStats Renderer::render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
+                                const std::atomic<bool>* cancel) {
+    const int n_threads = threads > 0 ? threads : omp_get_max_threads();
+    // Chosen per pass, so that a material edited in the viewer (which restarts the accumulation)
+    // switches the instantiation too. Both give the same image: the specialisation only drops code.
+    if (scene_is_diffuse_only(scene)) return run_pass<true>(scene, film, first_sample, spp, n_threads, cancel);
+    return run_pass<false>(scene, film, first_sample, spp, n_threads, cancel);
 }
 
 }  // namespace candela

@@ -43,6 +43,10 @@ public:
         return i;
     }
 
+    size_t memory_bytes() const {
+        return cdf_.capacity() * sizeof(double) + (cdf_f_.capacity() + pmf_.capacity()) * sizeof(float);
+    }
+
 private:
     std::vector<double> cdf_;
     std::vector<float> cdf_f_;

@@ -64,4 +64,14 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
     return si;
 }
 
+Scene::Memory Scene::memory() const {
+    Memory m;
+    m.triangles = mesh.triangles.size();
+    m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
+             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t);
+    m.accel = accel ? accel->memory_bytes() : 0;
+    m.lights = lights.memory_bytes();
+    return m;
+}
+
 }  // namespace candela

@@ -47,6 +47,15 @@ struct Scene {
 
     // Surface data at a hit, with the error bound of the point.
     SurfaceInteraction interaction(const Hit& hit) const;
+
+    // What the loaded scene holds in memory, by part. The mesh stores normals only where the file
+    // gives them and the light maps only when there are emitters, so a scene pays for what it uses.
+    struct Memory {
+        size_t triangles = 0;
+        size_t mesh = 0, accel = 0, lights = 0;  // bytes
+        size_t total() const { return mesh + accel + lights; }
+    };
+    Memory memory() const;
 };
 
 // Loads a scene by its extension: .xml (Mitsuba 3 subset) or .obj (OBJ + MTL). `defines` are
