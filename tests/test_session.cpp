@@ -7,6 +7,11 @@
 #include "render/launch.h"
 #include "render/renderer.h"
 #include "render/session.h"
+#include "core/error.h"
+#include <sched.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 using namespace candela;
 
@@ -229,4 +234,30 @@ TEST(Session, MeanRelativeChange) {
     EXPECT_NEAR(mean_relative_change(b, a, 0.f), 1.0, 1e-6);
     EXPECT_EQ(mean_relative_change(a, a), 0.0);
     EXPECT_EQ(mean_relative_change(a, {1, 1, 1}), 0.0);  // sizes differ
+}
+
+TEST(Session, RenderPriorityAppliesToTheWorker) {
+    EXPECT_EQ(parse_render_priority("idle"), RenderPriority::Idle);
+    EXPECT_EQ(parse_render_priority("low"), RenderPriority::Low);
+    EXPECT_EQ(parse_render_priority("normal"), RenderPriority::Normal);
+    EXPECT_THROW(parse_render_priority("high"), Error);
+    const int base_nice = getpriority(PRIO_PROCESS, 0);
+    for (RenderPriority p : {RenderPriority::Normal, RenderPriority::Low, RenderPriority::Idle}) {
+        SessionOptions opt;
+        opt.threads = 1;
+        opt.max_passes = 1;
+        opt.priority = p;
+        std::atomic<int> policy{-1}, nice{-100};  // outlive the session, whose worker writes them
+        RenderSession session(cornell(32, 24), opt);
+        // The publish callback runs on the worker thread: it sees that thread's own scheduling.
+        session.set_on_publish([&] {
+            policy = sched_getscheduler(0);
+            nice = getpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)));
+        });
+        ASSERT_TRUE(session.wait_for(0, 1, 120)) << render_priority_name(p);
+        session.reset();  // one more publish, certainly after the callback was set
+        ASSERT_TRUE(session.wait_for(1, 1, 120)) << render_priority_name(p);
+        EXPECT_EQ(policy.load(), p == RenderPriority::Idle ? SCHED_IDLE : SCHED_OTHER) << render_priority_name(p);
+        EXPECT_EQ(nice.load(), p == RenderPriority::Normal ? base_nice : 19) << render_priority_name(p);
+    }
 }

@@ -35,10 +35,14 @@ int main(int argc, char** argv) {
     app.add_option("--move-every", b.move_every, "Seconds between camera moves");
     app.add_option("--burst", b.moves_per_burst, "Frames per move that each change the camera");
     app.add_flag("--paused", b.paused, "No full passes (previews after each camera change only)");
+    std::string priority = "idle";
+    app.add_option("--render-priority", priority, "Render threads: normal, low (nice 19) or idle (SCHED_IDLE)")
+        ->check(CLI::IsMember({"normal", "low", "idle"}));
     CLI11_PARSE(app, argc, argv);
     vo.overrides.width = size;
     vo.overrides.height = size;
     vo.benchmark = &b;
+    vo.render_priority = parse_render_priority(priority);
     try {
         run_viewer(vo);
     } catch (const Error& e) {
@@ -46,12 +50,19 @@ int main(int argc, char** argv) {
         return 1;
     }
     int threads = vo.threads > 0 ? vo.threads : int(std::thread::hardware_concurrency());
-    std::printf("viewer %dx%d, %d render threads, %.0f s, %d frames, %zu camera changes measured\n", size, size,
-                threads, b.duration, b.frames, b.update_ms.size());
+    std::printf("viewer %dx%d, %d render threads (priority %s), %.0f s, %d frames, %zu camera changes measured\n",
+                size, size, threads, priority.c_str(), b.duration, b.frames, b.update_ms.size());
     std::printf("frame  ms: median %.2f  p90 %.2f  p99 %.2f  max %.2f\n", percentile(b.frame_ms, 0.5),
                 percentile(b.frame_ms, 0.9), percentile(b.frame_ms, 0.99), percentile(b.frame_ms, 1.0));
     std::printf("frame  CPU ms (window thread): median %.2f  p90 %.2f  p99 %.2f\n", percentile(b.frame_cpu_ms, 0.5),
                 percentile(b.frame_cpu_ms, 0.9), percentile(b.frame_cpu_ms, 0.99));
+    std::vector<double> with_image, without_image;
+    for (size_t i = 0; i < b.frame_ms.size(); ++i)
+        (b.frame_new_image[i] ? with_image : without_image).push_back(b.frame_ms[i]);
+    std::printf("frame  ms, frames that upload a new image (%zu): median %.2f  p99 %.2f; other frames (%zu): "
+                "median %.2f  p99 %.2f\n",
+                with_image.size(), percentile(with_image, 0.5), percentile(with_image, 0.99), without_image.size(),
+                percentile(without_image, 0.5), percentile(without_image, 0.99));
     std::printf("update ms: median %.2f  p90 %.2f  max %.2f\n", percentile(b.update_ms, 0.5),
                 percentile(b.update_ms, 0.9), percentile(b.update_ms, 1.0));
     return 0;

@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
                                       "Headless: continue the render saved in checkpoint FILE (same scene and options; "
                                       "--frames is the total)")
                            ->type_name("FILE");
+    std::string priority;
+    auto* prio_opt = app.add_option("--render-priority", priority,
+                                    "Viewer: CPU priority of the render threads: idle (default for a window: the "
+                                    "window and other programs first), low (nice 19) or normal (default for "
+                                    "--screenshot-after)")
+                         ->check(CLI::IsMember({"normal", "low", "idle"}));
     // --screenshot-after N FILE: one option with two values (a pair: CLI11 checks both types).
     std::pair<int, std::string> shot_args{0, ""};
     auto* shot = app.add_option("--screenshot-after", shot_args,
@@ -92,12 +98,14 @@ int main(int argc, char** argv) {
             vo.spp_per_frame = opt.spp_per_frame;
             vo.screenshot_after = shot_args.first;
             vo.screenshot = shot_args.second;
+            if (*prio_opt) vo.render_priority = parse_render_priority(priority);
             if (*shot && vo.screenshot_after < 1) throw Error("--screenshot-after expects N >= 1 passes");
             return run_viewer(vo);
         }
 #else
         (void)shot;
         (void)resume_opt;
+        (void)prio_opt;
 #endif
         if (opt.out.empty()) {
             opt.out = "candela.png";

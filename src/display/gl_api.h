@@ -68,7 +68,8 @@ namespace candela {
     X(void, DeleteFramebuffers, (GLsizei n, const GLuint* framebuffers)) \
     X(void, BindFramebuffer, (GLenum target, GLuint framebuffer)) \
     X(void, FramebufferTexture2D, (GLenum target, GLenum attachment, GLenum textarget, GLuint texture, GLint level)) \
-    X(GLenum, CheckFramebufferStatus, (GLenum target))
+    X(GLenum, CheckFramebufferStatus, (GLenum target)) \
+    X(void, BlitFramebuffer, (GLint srcX0, GLint srcY0, GLint srcX1, GLint srcY1, GLint dstX0, GLint dstY0, GLint dstX1, GLint dstY1, GLbitfield mask, GLenum filter))
 
 struct GlApi {
 #define CANDELA_GL_MEMBER(ret, name, params) ret(CANDELA_GLAPIENTRY* name) params = nullptr;

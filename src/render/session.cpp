@@ -1,11 +1,13 @@
 #include "render/session.h"
 #include <omp.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
+#include "core/error.h"
 #include "render/renderer.h"
 
 namespace candela {
@@ -211,14 +213,34 @@ void RenderSession::publish(const Film& film, bool preview, uint64_t gen, int pa
     if (notify) notify();
 }
 
+RenderPriority parse_render_priority(const std::string& s) {
+    if (s == "normal") return RenderPriority::Normal;
+    if (s == "low") return RenderPriority::Low;
+    if (s == "idle") return RenderPriority::Idle;
+    throw Error("unknown render priority '" + s + "' (expected normal, low or idle)");
+}
+
+const char* render_priority_name(RenderPriority p) {
+    switch (p) {
+        case RenderPriority::Normal: return "normal";
+        case RenderPriority::Low: return "low";
+        case RenderPriority::Idle: return "idle";
+    }
+    return "?";
+}
+
 void RenderSession::worker() {
-    if (opt_.nice > 0) {
-        // Linux schedules threads, not processes: this lowers the worker's priority, and the
-        // OpenMP threads it creates for its passes inherit it. Raising nice never needs privileges.
+    // Linux schedules threads, not processes: this lowers the worker's priority, and the OpenMP
+    // threads it creates for its passes inherit it (libgomp keeps a thread pool per master thread).
+    // Lowering a priority never needs privileges.
+    if (opt_.priority != RenderPriority::Normal) {
         const id_t tid = id_t(syscall(SYS_gettid));
-        errno = 0;
-        int cur = getpriority(PRIO_PROCESS, tid);
-        if (errno == 0) setpriority(PRIO_PROCESS, tid, std::min(19, cur + opt_.nice));
+        setpriority(PRIO_PROCESS, tid, 19);
+        if (opt_.priority == RenderPriority::Idle) {
+            sched_param sp{};
+            sp.sched_priority = 0;
+            sched_setscheduler(0, SCHED_IDLE, &sp);  // 0: the calling thread
+        }
     }
     Film full, preview;
     std::shared_ptr<Scene> scene;

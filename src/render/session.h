@@ -21,6 +21,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 #include "film/film.h"
@@ -38,6 +39,17 @@ struct SceneParams {
     static SceneParams from(const Scene& s) { return {s.camera, s.settings, s.materials, s.emitters}; }
 };
 
+// How the render threads share the CPU with the rest of the machine (Linux; elsewhere Normal).
+//   Normal  the default priority of the process
+//   Low     nice 19: every normal-priority thread is scheduled first, the render gets what is left
+//           (about 1.5% of a core against each busy normal thread)
+//   Idle    SCHED_IDLE: the render runs only on CPU time nothing else wants. On 2 cores with a
+//           software GL this is what keeps the window's frames on time (docs/viewer.md), but a
+//           busy machine can stall the render entirely.
+enum class RenderPriority { Normal, Low, Idle };
+RenderPriority parse_render_priority(const std::string& s);  // normal | low | idle; throws Error
+const char* render_priority_name(RenderPriority p);
+
 struct SessionOptions {
     int threads = 0;        // render threads; <= 0: all cores
     int spp_per_pass = 1;   // samples per pixel in each full-resolution pass
@@ -45,8 +57,7 @@ struct SessionOptions {
     double preview_budget = 0;  // > 0: seconds a preview pass should take; the scale grows (up
                                 // to 16) when the measured speed says preview_scale is too slow
     int max_passes = 0;     // idle after this many full passes (0: never), e.g. for screenshots
-    int nice = 0;           // > 0: lower the render threads' priority by this much (Linux nice),
-                            // so that a window's thread is scheduled first on a loaded machine
+    RenderPriority priority = RenderPriority::Normal;  // of the worker and its OpenMP threads
 };
 
 // A resolved image, as published to the front end.

@@ -2,10 +2,12 @@
 // The interactive viewer: a GLFW window that shows the film converging (through the shared display
 // program, the one tonemap), a Dear ImGui panel to edit the scene, and camera controls. Rendering
 // happens in a RenderSession; the window's thread never waits for a pass.
+#include <optional>
 #include <string>
 #include <vector>
 #include "display/display.h"
 #include "render/launch.h"
+#include "render/session.h"
 
 namespace candela {
 
@@ -22,6 +24,7 @@ struct ViewerBenchmark {
                                        // frame costs on an idle core (with LP_NUM_THREADS=0 the
                                        // software rasteriser runs in this thread too)
     std::vector<double> update_ms;  // camera change -> end of the first frame showing its image
+    std::vector<bool> frame_new_image;  // per frame: a new image was uploaded and tonemapped in it
     int frames = 0;
 };
 
@@ -33,6 +36,9 @@ struct ViewerOptions {
     int spp_per_frame = 1;       // samples per pixel in each full-resolution pass
     int screenshot_after = 0;    // > 0: render this many passes, save the window, exit
     std::string screenshot;      // PNG file for screenshot_after
+    // Render threads' priority; unset: Idle for an interactive window (the window first), Normal
+    // for --screenshot-after runs, where nobody is waiting on the window's frames.
+    std::optional<RenderPriority> render_priority;
     ViewerBenchmark* benchmark = nullptr;
 };
 
