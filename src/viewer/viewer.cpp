@@ -36,6 +36,27 @@ constexpr double kMaxUpdateDelay = 0.1;
 // While something animates (fly keys held), frames are paced at this rate.
 constexpr double kFrameInterval = 1.0 / 60.0;
 
+// (Re)allocates an RGBA8 texture of w x h and a framebuffer that renders into it.
+void ensure_color_target(const GlApi& gl, unsigned& fbo, unsigned& tex, int& cur_w, int& cur_h, int w, int h) {
+    if (w == cur_w && h == cur_h && fbo && tex) return;
+    if (!tex) gl.GenTextures(1, &tex);
+    if (!fbo) gl.GenFramebuffers(1, &fbo);
+    gl.BindTexture(GL_TEXTURE_2D, tex);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("viewer: the display cache framebuffer is incomplete");
+    cur_w = w;
+    cur_h = h;
+}
+
+
 double thread_cpu_seconds() {
     timespec ts;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -135,9 +156,13 @@ private:
 
     // The display shader's output for the current image, exposure and layout, kept in a texture:
     // the shader runs when one of those changes, not every frame (it is most of a frame's cost
-    // in a software GL), and ImGui draws the texture pixel for pixel.
+    // in a software GL), and each frame blits the texture to the window pixel for pixel.
     unsigned cache_fbo_ = 0, cache_tex_ = 0;
     int cache_w_ = 0, cache_h_ = 0;
+    // A preview goes through the shader at its own size into this target, then is scaled up into
+    // the cache by a bilinear blit (see update_display_cache).
+    unsigned small_fbo_ = 0, small_tex_ = 0;
+    int small_w_ = 0, small_h_ = 0;
     bool cache_valid_ = false;
     float cache_exposure_ = 0;
     void update_display_cache();
@@ -183,6 +208,8 @@ Viewer::~Viewer() {
         program_.reset();  // GL objects die with the context still current
         if (cache_fbo_) gl_.DeleteFramebuffers(1, &cache_fbo_);
         if (cache_tex_) gl_.DeleteTextures(1, &cache_tex_);
+        if (small_fbo_) gl_.DeleteFramebuffers(1, &small_fbo_);
+        if (small_tex_) gl_.DeleteTextures(1, &small_tex_);
         if (imgui_ready_) {
             ImGui_ImplOpenGL3_Shutdown();
             ImGui_ImplGlfw_Shutdown();
@@ -215,6 +242,27 @@ void Viewer::open_window(int image_w, int image_h) {
     glfwSwapInterval(opt_.benchmark || opt_.screenshot_after > 0 ? 0 : 1);
     gl_ = load_gl_api(reinterpret_cast<GlGetProcAddress>(glfwGetProcAddress));
     program_ = std::make_unique<DisplayProgram>(gl_);
+    {
+        // A software GL compiles each pipeline variant on first use (60 ms measured with llvmpipe,
+        // whose samplers are specialised on power-of-two texture sizes): run the preview's scaling
+        // blit now from a power-of-two and from another source, so that no camera change pays.
+        unsigned fbo = 0, tex = 0;
+        int cw = 0, ch = 0;
+        ensure_color_target(gl_, fbo, tex, cw, ch, 8, 8);
+        for (int n : {2, 3}) {
+            ensure_color_target(gl_, small_fbo_, small_tex_, small_w_, small_h_, n, n);
+            gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, small_fbo_);
+            gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+            gl_.BlitFramebuffer(0, 0, n, n, 0, 0, 8, 8, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+        }
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        std::vector<unsigned char> px(8 * 8 * 4);
+        gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+        gl_.ReadPixels(0, 0, 8, 8, GL_RGBA, GL_UNSIGNED_BYTE, px.data());  // waits for it to run
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        gl_.DeleteFramebuffers(1, &fbo);
+        gl_.DeleteTextures(1, &tex);
+    }
 
     glfwSetWindowUserPointer(window_, this);
     glfwSetDropCallback(window_, [](GLFWwindow* win, int count, const char** paths) {
@@ -609,30 +657,27 @@ void Viewer::panel_pick() {
     ImGui::Text("distance  %.4g", pick_.distance);
 }
 
+
 void Viewer::update_display_cache() {
     const int w = image_rect_.width, h = image_rect_.height;
     if (image_.rgb.empty() || w <= 0 || h <= 0) return;
     if (cache_valid_ && w == cache_w_ && h == cache_h_ && display_.exposure == cache_exposure_) return;
-    if (w != cache_w_ || h != cache_h_) {
-        if (!cache_tex_) gl_.GenTextures(1, &cache_tex_);
-        if (!cache_fbo_) gl_.GenFramebuffers(1, &cache_fbo_);
-        gl_.BindTexture(GL_TEXTURE_2D, cache_tex_);
-        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
-        // Nearest: drawn at its own size, each window pixel takes its texel unchanged.
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    ensure_color_target(gl_, cache_fbo_, cache_tex_, cache_w_, cache_h_, w, h);
+    if (image_.preview && image_.width < w && image_.height < h) {
+        // A preview is tonemapped at its own size (1/16 of the pixels), then scaled up by a
+        // bilinear blit: in a software GL the full-size shader pass cost ~13 ms per preview, and
+        // previews arrive every ~25 ms while the camera moves. (Filtering after the display
+        // transform, not before as for the full image; it is a stand-in until the full pass.)
+        ensure_color_target(gl_, small_fbo_, small_tex_, small_w_, small_h_, image_.width, image_.height);
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, small_fbo_);
+        program_->draw({0, 0, image_.width, image_.height}, display_, DisplayFilter::Nearest);
+        gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, small_fbo_);
+        gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, cache_fbo_);
+        gl_.BlitFramebuffer(0, 0, image_.width, image_.height, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    } else {
         gl_.BindFramebuffer(GL_FRAMEBUFFER, cache_fbo_);
-        gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cache_tex_, 0);
-        GLenum status = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER);
-        gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
-        if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("viewer: the display cache framebuffer is incomplete");
-        cache_w_ = w;
-        cache_h_ = h;
+        program_->draw({0, 0, w, h}, display_, image_.preview ? DisplayFilter::Linear : DisplayFilter::Nearest);
     }
-    gl_.BindFramebuffer(GL_FRAMEBUFFER, cache_fbo_);
-    program_->draw({0, 0, w, h}, display_, image_.preview ? DisplayFilter::Linear : DisplayFilter::Nearest);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
     check_gl_error(gl_, "display cache");
     cache_valid_ = true;
