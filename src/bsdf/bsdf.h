@@ -29,24 +29,37 @@ namespace candela {
 // docs/materials.md describes each model and its tests.
 using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf>;
 
-#if CANDELA_DIFFUSE_ONLY
-// The yardstick build for issue 6 (cmake -DCANDELA_DIFFUSE_ONLY=ON): the renderer's dispatch knows
-// only the diffuse BSDF, as a diffuse-only renderer would; any other BSDF renders black. It exists to
-// measure what the full variant costs a diffuse scene (docs/accuracy.md); not for real use.
-inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+// Dispatch that knows only the diffuse BSDF, as a diffuse-only renderer would have it; any other
+// BSDF renders black. Used in two places: the whole dispatch of the yardstick build for issue 6
+// (cmake -DCANDELA_DIFFUSE_ONLY=ON; not for real use), and the per-scene specialisation below.
+namespace diffuse_only {
+inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode) {
     const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
     return d ? d->eval(wo, wi, mode) : vec3(0.f);
 }
-inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode) {
     const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
     return d ? d->pdf(wo, wi, mode) : 0.f;
 }
-inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2,
-                                        TransportMode mode = TransportMode::Radiance) {
+inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2, TransportMode mode) {
     const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
     return d ? d->sample(wo, u1, u2, mode) : std::nullopt;
 }
 inline bool has_smooth_component(const Bsdf& b) { return std::holds_alternative<DiffuseBsdf>(b); }
+}  // namespace diffuse_only
+
+#if CANDELA_DIFFUSE_ONLY
+inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    return diffuse_only::eval(b, wo, wi, mode);
+}
+inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    return diffuse_only::pdf(b, wo, wi, mode);
+}
+inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2,
+                                        TransportMode mode = TransportMode::Radiance) {
+    return diffuse_only::sample(b, wo, u1, u2, mode);
+}
+inline bool has_smooth_component(const Bsdf& b) { return diffuse_only::has_smooth_component(b); }
 #else
 inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     return std::visit([&](const auto& x) { return x.eval(wo, wi, mode); }, b);
@@ -65,44 +78,28 @@ inline bool has_smooth_component(const Bsdf& b) {
 #endif
 
 // Dispatch chosen per scene (render/renderer.cpp): when every material of a scene is diffuse, the
-// renderer instantiates the path tracer with DiffuseOnly = true, and these compile to the very code
-// of the diffuse-only build above -- no variant dispatch, no code for the other lobes in the loop.
-// A non-diffuse BSDF never reaches the DiffuseOnly instantiation; if one did, it would render black.
+// renderer instantiates the path tracer with DiffuseOnly = true, and these compile to the
+// diffuse-only build's code: no variant dispatch, no code for the other lobes in the loop.
 template <bool DiffuseOnly>
 inline vec3 eval_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
-    if constexpr (DiffuseOnly) {
-        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
-        return d ? d->eval(wo, wi, mode) : vec3(0.f);
-    } else {
-        return eval(b, wo, wi, mode);
-    }
+    if constexpr (DiffuseOnly) return diffuse_only::eval(b, wo, wi, mode);
+    else return eval(b, wo, wi, mode);
 }
 template <bool DiffuseOnly>
 inline float pdf_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
-    if constexpr (DiffuseOnly) {
-        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
-        return d ? d->pdf(wo, wi, mode) : 0.f;
-    } else {
-        return pdf(b, wo, wi, mode);
-    }
+    if constexpr (DiffuseOnly) return diffuse_only::pdf(b, wo, wi, mode);
+    else return pdf(b, wo, wi, mode);
 }
 template <bool DiffuseOnly>
 inline std::optional<BsdfSample> sample_in(const Bsdf& b, vec3 wo, float u1, vec2 u2,
                                            TransportMode mode = TransportMode::Radiance) {
-    if constexpr (DiffuseOnly) {
-        const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
-        return d ? d->sample(wo, u1, u2, mode) : std::nullopt;
-    } else {
-        return sample(b, wo, u1, u2, mode);
-    }
+    if constexpr (DiffuseOnly) return diffuse_only::sample(b, wo, u1, u2, mode);
+    else return sample(b, wo, u1, u2, mode);
 }
 template <bool DiffuseOnly>
 inline bool has_smooth_component_in(const Bsdf& b) {
-    if constexpr (DiffuseOnly) {
-        return std::holds_alternative<DiffuseBsdf>(b);
-    } else {
-        return has_smooth_component(b);
-    }
+    if constexpr (DiffuseOnly) return diffuse_only::has_smooth_component(b);
+    else return has_smooth_component(b);
 }
 
 // Derives what a BSDF precomputes from its parameters (the plastic coat's tables). Call it after
