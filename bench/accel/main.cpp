@@ -10,6 +10,7 @@
 // The camera and the bounce rays follow ../shared/tools/embree_bench (same framing, same hash for
 // the random numbers), so that the two programs trace comparable ray sets; for bit-identical sets
 // use its --dump-rays files with --rays here.
+// A scene file (.xml) without --view takes its primary rays from the scene's own camera.
 #include <omp.h>
 #include <tiny_obj_loader.h>
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -64,10 +66,13 @@ bool ends_with(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-// OBJ straight into a Mesh (all shapes, positions only); a scene file through load_scene().
-Mesh load_mesh(const std::string& path) {
+// OBJ straight into a Mesh (all shapes, positions only); a scene file through load_scene(), whose
+// camera then makes the primary rays (a camera framing the bounds from outside would see, say, the
+// Cornell box from behind, and its bounce rays would leave the box).
+Mesh load_mesh(const std::string& path, std::optional<Camera>* camera = nullptr) {
     if (ends_with(path, ".xml")) {
         Scene scene = load_scene(path);
+        if (camera) *camera = scene.camera;
         return std::move(scene.mesh);
     }
     tinyobj::ObjReaderConfig cfg;
@@ -327,7 +332,7 @@ int main(int argc, char** argv) try {
     int W = 1024, H = 1024, repeat = 3, threads = 0, bisect_rounds = 0, scaling = -1;
     uint32_t seed = 1;
     vec3 view(0.3f, 0.4f, 1.f);
-    bool stadium = false;
+    bool stadium = false, view_given = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -345,6 +350,7 @@ int main(int argc, char** argv) try {
         else if (a == "--build-scaling") scaling = std::atoi(next().c_str());
         else if (a == "--stadium") stadium = true;
         else if (a == "--view") {
+            view_given = true;
             if (std::sscanf(next().c_str(), "%f,%f,%f", &view.x, &view.y, &view.z) != 3) usage();
         } else if (a == "-h" || a == "--help" || (!a.empty() && a[0] == '-')) usage();
         else inputs.push_back(a);
@@ -359,7 +365,8 @@ int main(int argc, char** argv) try {
     const int nthreads = threads > 0 ? threads : omp_get_max_threads();
     if (threads > 0) omp_set_num_threads(threads);
 
-    Mesh mesh = load_mesh(inputs[0]);
+    std::optional<Camera> scene_camera;
+    Mesh mesh = load_mesh(inputs[0], &scene_camera);
     for (int k = 0; k < bisect_rounds; ++k) bisect(mesh, uint32_t(k));
     if (stadium) add_stadium(mesh);
     const size_t ntris = mesh.triangles.size();
@@ -407,7 +414,20 @@ int main(int argc, char** argv) try {
     std::printf("mesh: %s%s%s, %zu triangles; rays %dx%d; threads 1 and %d; best of %d\n", inputs[0].c_str(),
                 stadium ? " + stadium" : "", bisect_rounds ? (" bisected x" + std::to_string(bisect_rounds)).c_str() : "",
                 ntris, W, H, nthreads, repeat);
-    std::vector<RayRecord> primary = primary_rays(mesh, W, H, view);
+    std::vector<RayRecord> primary;
+    if (scene_camera && !stadium && !view_given) {
+        // Through pixel centres, in scanline order, like primary_rays(); tmax from the far clip.
+        scene_camera->set_film_size(W, H);
+        primary.reserve(size_t(W) * H);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                Ray r = scene_camera->generate_ray(vec2(float(x) + 0.5f, float(y) + 0.5f));
+                primary.push_back({{r.o.x, r.o.y, r.o.z}, {r.d.x, r.d.y, r.d.z}, r.tmax});
+            }
+        std::printf("primary rays from the scene's camera\n");
+    } else {
+        primary = primary_rays(mesh, W, H, view);
+    }
     std::vector<RayRecord> bounce;
     {
         KdTreeAccel ref(mesh);  // rays are generated once, with the k-d tree, for every accelerator
@@ -422,7 +442,14 @@ int main(int argc, char** argv) try {
         const double bpt = ntris ? double(b.accel->memory_bytes()) / double(ntris) : 0.0;
         for (int set = 0; set < 2; ++set) {
             const auto& rays = set == 0 ? primary : bounce;
+            kd_trace_counters() = {};
             Result c1 = trace(*b.accel, rays, false, 1, repeat);
+#ifdef CANDELA_KD_COUNTERS
+            if (const KdTraceCounters& c = kd_trace_counters(); c.rays > 0)
+                std::fprintf(stderr, "[%s %s closest] per ray: %.2f nodes, %.2f leaves, %.2f triangle tests\n",
+                             name.c_str(), set == 0 ? "primary" : "bounce", double(c.nodes) / double(c.rays),
+                             double(c.leaves) / double(c.rays), double(c.tris) / double(c.rays));
+#endif
             Result cn = trace(*b.accel, rays, false, nthreads, repeat);
             Result a1 = trace(*b.accel, rays, true, 1, repeat);
             Result an = trace(*b.accel, rays, true, nthreads, repeat);
