@@ -427,14 +427,15 @@ namespace {
 struct RayData {
     float o[3], d[3], inv_d[3];
     bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
-    int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide edge test
-    float sx, sy;
+    int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide filter
+    float sx, sy, sz;
     RayData(const Ray& ray, const RayShear& sh) {
         kx = sh.kx;
         ky = sh.ky;
         kz = sh.kz;
         sx = sh.sx;
         sy = sh.sy;
+        sz = sh.sz;
         for (int i = 0; i < 3; ++i) {
             o[i] = ray.o[i];
             d[i] = ray.d[i];
@@ -444,13 +445,15 @@ struct RayData {
     }
 };
 
-// The first half of intersect_triangle() (geometry/triangle.h) on four triangles at once: the
-// translation, the shear and the three edge functions, with the same float operations in the
-// same order (no FMA at -march=x86-64-v2), so each lane's edge values are bit-identical to the
-// scalar test's. Returns the lanes that test would not reject at its edge-sign check (any edge
-// exactly 0 -- redone in double there -- or NaN counts as not rejected); the caller runs the
-// scalar test on those, so the filter decides nothing the shared test would not.
-inline unsigned edge_filter4(const RayData& r, const KdTree::Tri* const t[4]) {
+// The rejection tests of intersect_triangle() (geometry/triangle.h) on four triangles at once: the
+// translation, the shear, the three edge functions, the determinant and the scaled distance, with the
+// same float operations in the same order (no FMA at -march=x86-64-v2), so each lane's values are
+// bit-identical to the scalar test's. Returns the lanes that test would not reject at its edge-sign
+// check or at its [tmin, tmax] check (any edge exactly 0 -- redone in double there -- or NaN counts
+// as not rejected); the caller runs the scalar test on those, so the filter decides nothing the
+// shared test would not. The distance check matters: a lane whose edges pass is a triangle the ray's
+// line crosses, often behind the origin or beyond the closest hit so far (the far wall of a room).
+inline unsigned triangle_filter4(const RayData& r, const KdTree::Tri* const t[4], float tmin, float tmax) {
     __m128 p[3][3];  // p[vertex][axis], four triangles per register
     for (int v = 0; v < 3; ++v) {
         __m128 r0 = _mm_loadu_ps(&t[0]->p0.x + 3 * v), r1 = _mm_loadu_ps(&t[1]->p0.x + 3 * v);
@@ -460,15 +463,16 @@ inline unsigned edge_filter4(const RayData& r, const KdTree::Tri* const t[4]) {
         p[v][1] = r1;
         p[v][2] = r2;
     }
-    const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy);
-    __m128 x[3], y[3];
+    const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy), sz = _mm_set1_ps(r.sz);
+    __m128 x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
-        // a = p - o, then a[kx] + sx * a[kz] and a[ky] + sy * a[kz].
+        // a = p - o, then a[kx] + sx * a[kz], a[ky] + sy * a[kz] and sz * a[kz].
         const __m128 ax = _mm_sub_ps(p[v][r.kx], _mm_set1_ps(r.o[r.kx]));
         const __m128 ay = _mm_sub_ps(p[v][r.ky], _mm_set1_ps(r.o[r.ky]));
         const __m128 az = _mm_sub_ps(p[v][r.kz], _mm_set1_ps(r.o[r.kz]));
         x[v] = _mm_add_ps(ax, _mm_mul_ps(sx, az));
         y[v] = _mm_add_ps(ay, _mm_mul_ps(sy, az));
+        z[v] = _mm_mul_ps(sz, az);
     }
     const __m128 e0 = _mm_sub_ps(_mm_mul_ps(x[1], y[2]), _mm_mul_ps(y[1], x[2]));
     const __m128 e1 = _mm_sub_ps(_mm_mul_ps(x[2], y[0]), _mm_mul_ps(y[2], x[0]));
@@ -477,8 +481,16 @@ inline unsigned edge_filter4(const RayData& r, const KdTree::Tri* const t[4]) {
     const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
     const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)), _mm_cmpgt_ps(e2, zero));
     const __m128 any_zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero));
-    // Rejected: some edge negative and some positive, and none exactly zero.
-    const __m128 rejected = _mm_andnot_ps(any_zero, _mm_and_ps(any_neg, any_pos));
+    // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
+    // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
+    const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
+    const __m128 ts = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, z[0]), _mm_mul_ps(e1, z[1])), _mm_mul_ps(e2, z[2]));
+    const __m128 lo = _mm_mul_ps(_mm_set1_ps(tmin), det), hi = _mm_mul_ps(_mm_set1_ps(tmax), det);
+    const __m128 out_neg = _mm_and_ps(_mm_cmplt_ps(det, zero), _mm_or_ps(_mm_cmpge_ps(ts, lo), _mm_cmple_ps(ts, hi)));
+    const __m128 out_pos = _mm_and_ps(_mm_cmpgt_ps(det, zero), _mm_or_ps(_mm_cmple_ps(ts, lo), _mm_cmpge_ps(ts, hi)));
+    // Rejected: some edge negative and some positive, or t outside the interval; and no edge exactly 0.
+    const __m128 rejected =
+        _mm_andnot_ps(any_zero, _mm_or_ps(_mm_and_ps(any_neg, any_pos), _mm_or_ps(out_neg, out_pos)));
     return unsigned(~_mm_movemask_ps(rejected)) & 15u;
 }
 
@@ -563,8 +575,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
                 const Tri* t4[4];
                 const uint32_t n4 = std::min(count - i, 4u);
                 for (uint32_t k = 0; k < 4; ++k) t4[k] = tris_.data() + slots[i + std::min(k, n4 - 1)];
-                // Only the lanes that the 4-wide edge test cannot reject go to the scalar test.
-                unsigned mask = edge_filter4(r, t4) & ((1u << n4) - 1u);
+                // Only the lanes that the 4-wide filter cannot reject go to the scalar test.
+                unsigned mask = triangle_filter4(r, t4, ray.tmin, ray.tmax) & ((1u << n4) - 1u);
                 while (mask) {
                     const int k = __builtin_ctz(mask);
                     mask &= mask - 1;
