@@ -517,6 +517,33 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     const Node* node = nodes;
     float tmax = ray.tmax;
     bool found = false;
+    if (t0 == 0.f) {
+        // The segment starts at the origin (inside the root box): every node on the way down
+        // holds the origin, so the next node is always the child on the origin's side (the exact
+        // test of the general step below), and the other child is pushed when the ray reaches the
+        // plane inside the segment. The general step visits the same nodes with the same
+        // intervals, but its branches on tp mispredict here: masks instead of branches make the
+        // walk from the root to a surface point (half of a bounce or shadow ray's node visits)
+        // ~10-20% faster (docs/accel.md).
+        const __m128 zero = _mm_setzero_ps(), up = _mm_set_ss(kWidenUp), down = _mm_set_ss(kWidenDown);
+        while (!node->leaf()) {
+            KD_COUNT(nodes, 1);
+            const int a = node->axis();
+            const float split = node->split;
+            const float oa = r.o[a];
+            const int above = int(oa > split) | (int(oa == split) & int(!r.d_nonpos[a]));
+            const Node* below = nodes + node->children();
+            // Pushed unless the plane is behind (tp <= 0) or beyond the segment; a NaN tp (the
+            // ray lies in the plane) pushes over the whole segment (max_ss / min_ss return their
+            // second operand for a NaN).
+            const __m128 tp = _mm_set_ss((split - oa) * r.inv_d[a]), vt1 = _mm_set_ss(t1);
+            const __m128 push = _mm_and_ps(_mm_cmpnle_ss(tp, zero), _mm_cmpngt_ss(tp, _mm_mul_ss(vt1, up)));
+            stack[sp] = {below + (1 - above), _mm_cvtss_f32(_mm_max_ss(_mm_mul_ss(tp, down), zero)), t1};
+            sp += _mm_movemask_ps(push) & 1;
+            t1 = _mm_cvtss_f32(_mm_blendv_ps(vt1, _mm_min_ss(_mm_mul_ss(tp, up), vt1), push));
+            node = below + above;
+        }
+    }
     for (;;) {
         KD_COUNT(nodes, 1);
         if (!node->leaf()) {
