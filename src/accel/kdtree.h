@@ -22,8 +22,10 @@ namespace candela {
 struct KdBuildOptions {
     // Surface area heuristic: cost = traversal + intersection * (P_left N_left + P_right N_right),
     // times (1 - empty_bonus) when one side is empty. Units: one triangle test = intersection.
+    // A triangle costs a third of a node step: leaves are tested four at a time by the SSE filter,
+    // while a node step is a dependent load and a branch (sweep in docs/accel.md).
     float traversal_cost = 1.f;
-    float intersection_cost = 0.8f;
+    float intersection_cost = 0.3f;
     float empty_bonus = 0.1f;
     int max_stalls = 3;        // consecutive splits that keep all triangles on one side (see .cpp)
     int max_depth = -1;        // -1: 8 + 1.3 log2(N), capped by the traversal stack
