@@ -270,7 +270,7 @@ constexpr float kWidenDown = 1.f - 1.f / 65536.f;
 
 void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AABB* clip, const KdBuildOptions& opt) {
     nodes_.clear();
-    tris_.clear();
+    blocks_.clear();
     bounds_ = AABB();
     stats_ = {};
 
@@ -321,21 +321,27 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     // first: a pair, its children's pairs, one more. A ray descending through a treelet's 2-3
     // levels then touches one or two cache lines instead of one per level, which is what
     // incoherent rays pay for: the deep levels are never in cache. Treelets follow each other in
-    // depth-first order; a leaf's triangles get their slot in tris_ when a leaf first meets them.
+    // depth-first order, and so do the leaves' triangle blocks.
     struct Flatten {
         KdTree& t;
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
-        std::vector<uint32_t> slot;  // builder-local triangle -> slot in t.tris_
-        uint32_t slot_of(uint32_t p) {
-            if (slot[p] == UINT32_MAX) {
-                slot[p] = uint32_t(t.tris_.size());
-                Tri tri;
-                tri.prim = list[p];
-                mesh.vertices(tri.prim, tri.p0, tri.p1, tri.p2);
-                t.tris_.push_back(tri);
+        // Appends the leaf's triangles as blocks of four (the last lane repeated to fill a block).
+        uint32_t add_blocks(const std::vector<uint32_t>& prims) {
+            const uint32_t first = uint32_t(t.blocks_.size());
+            for (size_t i = 0; i < prims.size(); i += 4) {
+                TriBlock b;
+                for (size_t k = 0; k < 4; ++k) {
+                    const uint32_t prim = list[prims[std::min(i + k, prims.size() - 1)]];
+                    vec3 v[3];
+                    mesh.vertices(prim, v[0], v[1], v[2]);
+                    for (int j = 0; j < 3; ++j)
+                        for (int a = 0; a < 3; ++a) b.v[j][a][k] = v[j][a];
+                    b.prim[k] = prim;
+                }
+                t.blocks_.push_back(b);
             }
-            return slot[p];
+            return first;
         }
         // Writes a leaf, or an interior node whose children index is patched when its pair is placed.
         void write(uint32_t idx, const BuildNode* bn, int depth) {
@@ -347,13 +353,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                 return;
             }
             const size_t n = bn->prims.size();
-            uint32_t first = 0;
-            if (n == 1) {
-                first = slot_of(bn->prims[0]);
-            } else if (n > 1) {
-                first = uint32_t(t.refs_.size());
-                for (uint32_t p : bn->prims) t.refs_.push_back(slot_of(p));
-            }
+            const uint32_t first = n > 0 ? add_blocks(bn->prims) : 0;
             t.nodes_[idx].first = first;
             t.nodes_[idx].bits = (uint32_t(n) << 2) | 3u;
             ++t.stats_.leaves;
@@ -399,15 +399,14 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             }
         }
     };
-    Flatten{*this, mesh, list, std::vector<uint32_t>(list.size(), UINT32_MAX)}.run(*root);
+    Flatten{*this, mesh, list}.run(*root);
     nodes_.shrink_to_fit();
-    tris_.shrink_to_fit();
-    refs_.shrink_to_fit();
+    blocks_.shrink_to_fit();
     stats_.nodes = nodes_.size();
 }
 
 size_t KdTree::memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + tris_.capacity() * sizeof(Tri) + refs_.capacity() * sizeof(uint32_t);
+    return nodes_.capacity() * sizeof(Node) + blocks_.capacity() * sizeof(TriBlock);
 }
 
 KdTraceCounters& kd_trace_counters() {
@@ -453,23 +452,14 @@ struct RayData {
 // as not rejected); the caller runs the scalar test on those, so the filter decides nothing the
 // shared test would not. The distance check matters: a lane whose edges pass is a triangle the ray's
 // line crosses, often behind the origin or beyond the closest hit so far (the far wall of a room).
-inline unsigned triangle_filter4(const RayData& r, const KdTree::Tri* const t[4], float tmin, float tmax) {
-    __m128 p[3][3];  // p[vertex][axis], four triangles per register
-    for (int v = 0; v < 3; ++v) {
-        __m128 r0 = _mm_loadu_ps(&t[0]->p0.x + 3 * v), r1 = _mm_loadu_ps(&t[1]->p0.x + 3 * v);
-        __m128 r2 = _mm_loadu_ps(&t[2]->p0.x + 3 * v), r3 = _mm_loadu_ps(&t[3]->p0.x + 3 * v);
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        p[v][0] = r0;
-        p[v][1] = r1;
-        p[v][2] = r2;
-    }
+inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax) {
     const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy), sz = _mm_set1_ps(r.sz);
     __m128 x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
         // a = p - o, then a[kx] + sx * a[kz], a[ky] + sy * a[kz] and sz * a[kz].
-        const __m128 ax = _mm_sub_ps(p[v][r.kx], _mm_set1_ps(r.o[r.kx]));
-        const __m128 ay = _mm_sub_ps(p[v][r.ky], _mm_set1_ps(r.o[r.ky]));
-        const __m128 az = _mm_sub_ps(p[v][r.kz], _mm_set1_ps(r.o[r.kz]));
+        const __m128 ax = _mm_sub_ps(_mm_load_ps(b.v[v][r.kx]), _mm_set1_ps(r.o[r.kx]));
+        const __m128 ay = _mm_sub_ps(_mm_load_ps(b.v[v][r.ky]), _mm_set1_ps(r.o[r.ky]));
+        const __m128 az = _mm_sub_ps(_mm_load_ps(b.v[v][r.kz]), _mm_set1_ps(r.o[r.kz]));
         x[v] = _mm_add_ps(ax, _mm_mul_ps(sx, az));
         y[v] = _mm_add_ps(ay, _mm_mul_ps(sy, az));
         z[v] = _mm_mul_ps(sz, az);
@@ -580,35 +570,32 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         KD_COUNT(tris, count);
         // Tests one triangle with the shared watertight test itself, so that every hit is
         // bit-identical to brute force.
-        auto test = [&](const Tri* lt) {
+        auto test = [&](const TriBlock& b, int k) {
             TriangleHit th;
-            if (!intersect_triangle(ray, sh, lt->p0, lt->p1, lt->p2, th)) return false;
+            const vec3 p0(b.v[0][0][k], b.v[0][1][k], b.v[0][2][k]);
+            const vec3 p1(b.v[1][0][k], b.v[1][1][k], b.v[1][2][k]);
+            const vec3 p2(b.v[2][0][k], b.v[2][1][k], b.v[2][2][k]);
+            if (!intersect_triangle(ray, sh, p0, p1, p2, th)) return false;
             if constexpr (!Shadow) {
                 tmax = th.t;
                 ray.tmax = th.t;
                 hit->t = th.t;
                 hit->b1 = th.b1;
                 hit->b2 = th.b2;
-                hit->prim = lt->prim;
+                hit->prim = b.prim[k];
                 found = true;
             }
             return true;
         };
-        if (count == 1) {
-            if (test(tris_.data() + node->first) && Shadow) return true;
-        } else {
-            const uint32_t* slots = refs_.data() + node->first;
-            for (uint32_t i = 0; i < count; i += 4) {
-                const Tri* t4[4];
-                const uint32_t n4 = std::min(count - i, 4u);
-                for (uint32_t k = 0; k < 4; ++k) t4[k] = tris_.data() + slots[i + std::min(k, n4 - 1)];
-                // Only the lanes that the 4-wide filter cannot reject go to the scalar test.
-                unsigned mask = triangle_filter4(r, t4, ray.tmin, ray.tmax) & ((1u << n4) - 1u);
-                while (mask) {
-                    const int k = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    if (test(t4[k]) && Shadow) return true;
-                }
+        const TriBlock* b = blocks_.data() + node->first;
+        for (uint32_t i = 0; i < count; i += 4, ++b) {
+            // Only the lanes that the 4-wide filter cannot reject go to the scalar test.
+            const uint32_t n4 = std::min(count - i, 4u);
+            unsigned mask = triangle_filter4(r, *b, ray.tmin, ray.tmax) & ((1u << n4) - 1u);
+            while (mask) {
+                const int k = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (test(*b, k) && Shadow) return true;
             }
         }
         // Next node in ray order, skipping those that start beyond the closest hit (with slack, so

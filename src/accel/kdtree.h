@@ -8,8 +8,8 @@
 // clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
 //
 // Traversal: 8-byte nodes, a fixed-size stack, template <bool Shadow> for the any-hit variant.
-// Leaves hold one triangle slot inline or a list of slots into one array of triangle copies
-// (three vertices + the triangle index, one copy per triangle). Every triangle test
+// Leaves hold their triangles' vertices in blocks of four, laid out for the 4-wide filter (a copy
+// per leaf reference). Every triangle test
 // is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the same t,
 // bit for bit, as the brute-force oracle.
 #include <cstdint>
@@ -66,9 +66,8 @@ public:
     const KdTreeStats& stats() const { return stats_; }
 
     // Compact node: an interior node keeps the split position and the index of its first child
-    // ("below" the plane; the "above" child follows it: siblings are adjacent). A leaf keeps its triangle count and
-    // `first`: the triangle's slot in tris_ itself when it holds one triangle (no indirection
-    // for the commonest leaf), else the offset of its slot list in refs_.
+    // ("below" the plane; the "above" child follows it: siblings are adjacent). A leaf keeps its
+    // triangle count and `first`, the index of its first TriBlock.
     struct Node {
         union {
             float split;
@@ -82,20 +81,21 @@ public:
     };
     static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
 
-    // One triangle's vertices (copied once per triangle, not per leaf reference), in the order
-    // the depth-first node layout first meets them, so that neighbouring leaves share lines.
-    struct Tri {
-        vec3 p0, p1, p2;
-        uint32_t prim;
+    // Four triangles of a leaf, vertex coordinates by axis and lane (v[vertex][axis][lane]), so
+    // that the 4-wide filter loads them as they are; a leaf holds ceil(count / 4) blocks, the last
+    // lane repeated to fill the last one.
+    struct alignas(16) TriBlock {
+        float v[3][3][4];
+        uint32_t prim[4];
     };
+    static_assert(sizeof(TriBlock) == 160, "a block is 4 triangles");
 
 private:
     template <bool Shadow>
     bool trace(Ray& ray, Hit* hit) const;
 
     std::vector<Node> nodes_;
-    std::vector<Tri> tris_;
-    std::vector<uint32_t> refs_;  // slot lists of the leaves with two or more triangles
+    std::vector<TriBlock> blocks_;  // the leaves' triangles, leaf by leaf
     AABB bounds_;
     KdTreeStats stats_;
 };
