@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include "core/error.h"
 #include "geometry/triangle.h"
 
 namespace candela {
@@ -384,11 +385,13 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                     }
                     ++placed;
                     const uint32_t c = uint32_t(t.nodes_.size());
+                    if (c + 2 > KdTree::kMaxNodes) throw Error("k-d tree: more than 2^28 nodes");
                     t.nodes_.emplace_back();
                     t.nodes_.emplace_back();
-                    t.nodes_[p.parent_idx].bits |= c << 2;
+                    t.nodes_[p.parent_idx].bits |= c << 4;
                     for (int k = 0; k < 2; ++k) {
                         const BuildNode* ch = p.parent->child[k].get();
+                        if (ch->axis < 0 && ch->prims.empty()) t.nodes_[p.parent_idx].bits |= 4u << k;
                         write(c + uint32_t(k), ch, p.depth);
                         if (ch->axis >= 0 && qn < 8) q[qn++] = {ch, c + uint32_t(k), p.depth + 1};
                         else if (ch->axis >= 0) work.push_back({ch, c + uint32_t(k), p.depth + 1});
@@ -426,6 +429,9 @@ namespace {
 struct RayData {
     float o[3], d[3], inv_d[3];
     bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
+    // The origin as compared with split planes: o_above[a] > split exactly when the origin lies
+    // above the plane, or on it moving up (o rounded up to the next float when d > 0).
+    float o_above[3];
     int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide filter
     float sx, sy, sz;
     RayData(const Ray& ray, const RayShear& sh) {
@@ -440,6 +446,7 @@ struct RayData {
             d[i] = ray.d[i];
             inv_d[i] = 1.f / ray.d[i];
             d_nonpos[i] = ray.d[i] <= 0.f;
+            o_above[i] = d_nonpos[i] ? o[i] : next_float_up(o[i]);
         }
     }
 };
@@ -452,7 +459,7 @@ struct RayData {
 // as not rejected); the caller runs the scalar test on those, so the filter decides nothing the
 // shared test would not. The distance check matters: a lane whose edges pass is a triangle the ray's
 // line crosses, often behind the origin or beyond the closest hit so far (the far wall of a room).
-inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax) {
+inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes) {
     const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy), sz = _mm_set1_ps(r.sz);
     __m128 x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
@@ -467,10 +474,14 @@ inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, fl
     const __m128 e0 = _mm_sub_ps(_mm_mul_ps(x[1], y[2]), _mm_mul_ps(y[1], x[2]));
     const __m128 e1 = _mm_sub_ps(_mm_mul_ps(x[2], y[0]), _mm_mul_ps(y[2], x[0]));
     const __m128 e2 = _mm_sub_ps(_mm_mul_ps(x[0], y[1]), _mm_mul_ps(y[0], x[1]));
+    // Edge test. With no edge exactly 0 (those are redone in double by the scalar test and never
+    // rejected here), "some edge negative and some positive" is "the sign bits differ". A NaN edge
+    // may go either way: the scalar test rejects NaN lanes too.
     const __m128 zero = _mm_setzero_ps();
-    const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
-    const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)), _mm_cmpgt_ps(e2, zero));
     const __m128 any_zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero));
+    const __m128 signs_differ = _mm_or_ps(_mm_xor_ps(e0, e1), _mm_xor_ps(e0, e2));
+    const unsigned edge_out = unsigned(_mm_movemask_ps(_mm_andnot_ps(any_zero, signs_differ)));
+    if ((edge_out | ~lanes) == 15u) return 0;  // the usual case: the ray misses all four
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
     // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
     const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
@@ -478,10 +489,9 @@ inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, fl
     const __m128 lo = _mm_mul_ps(_mm_set1_ps(tmin), det), hi = _mm_mul_ps(_mm_set1_ps(tmax), det);
     const __m128 out_neg = _mm_and_ps(_mm_cmplt_ps(det, zero), _mm_or_ps(_mm_cmpge_ps(ts, lo), _mm_cmple_ps(ts, hi)));
     const __m128 out_pos = _mm_and_ps(_mm_cmpgt_ps(det, zero), _mm_or_ps(_mm_cmple_ps(ts, lo), _mm_cmpge_ps(ts, hi)));
-    // Rejected: some edge negative and some positive, or t outside the interval; and no edge exactly 0.
-    const __m128 rejected =
-        _mm_andnot_ps(any_zero, _mm_or_ps(_mm_and_ps(any_neg, any_pos), _mm_or_ps(out_neg, out_pos)));
-    return unsigned(~_mm_movemask_ps(rejected)) & 15u;
+    // Rejected: t outside the interval (and no edge exactly 0), or by the edge test.
+    const unsigned t_out = unsigned(_mm_movemask_ps(_mm_andnot_ps(any_zero, _mm_or_ps(out_neg, out_pos))));
+    return ~(edge_out | t_out) & lanes;
 }
 
 }  // namespace
@@ -516,21 +526,25 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         // walk from the root to a surface point (half of a bounce or shadow ray's node visits)
         // ~10-20% faster (docs/accel.md).
         const __m128 zero = _mm_setzero_ps(), up = _mm_set_ss(kWidenUp), down = _mm_set_ss(kWidenDown);
+        const __m128 inf = _mm_set_ss(kInfinity);
         while (!node->leaf()) {
             KD_COUNT(nodes, 1);
             const int a = node->axis();
             const float split = node->split;
             const float oa = r.o[a];
-            const int above = int(oa > split) | (int(oa == split) & int(!r.d_nonpos[a]));
+            const int above = int(r.o_above[a] > split);
             const Node* below = nodes + node->children();
             // Pushed unless the plane is behind (tp <= 0) or beyond the segment; a NaN tp (the
-            // ray lies in the plane) pushes over the whole segment (max_ss / min_ss return their
-            // second operand for a NaN).
+            // ray lies in the plane) pushes over the whole segment (max_ss returns its second
+            // operand for a NaN). The segment's end is a running minimum over the planes ahead
+            // (min(t1, tp) when tp > 0, which leaves t1 alone where nothing was pushed), so its
+            // update does not wait for the push decision.
             const __m128 tp = _mm_set_ss((split - oa) * r.inv_d[a]), vt1 = _mm_set_ss(t1);
+            const __m128 ahead = _mm_cmpgt_ss(tp, zero);
             const __m128 push = _mm_and_ps(_mm_cmpnle_ss(tp, zero), _mm_cmpngt_ss(tp, _mm_mul_ss(vt1, up)));
             stack[sp] = {below + (1 - above), _mm_cvtss_f32(_mm_max_ss(_mm_mul_ss(tp, down), zero)), t1};
-            sp += _mm_movemask_ps(push) & 1;
-            t1 = _mm_cvtss_f32(_mm_blendv_ps(vt1, _mm_min_ss(_mm_mul_ss(tp, up), vt1), push));
+            sp += _mm_movemask_ps(push) & int(node->empty_child(1 - above) ^ 1u);
+            t1 = _mm_cvtss_f32(_mm_min_ss(vt1, _mm_blendv_ps(inf, _mm_mul_ss(tp, up), ahead)));
             node = below + above;
         }
     }
@@ -553,18 +567,26 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             // (std::max / std::min return their first argument for a NaN second). Branches, not
             // selects: a branch-free step measured the same on bounce rays and ~15% slower on
             // (well predicted) primary rays.
+            // An empty child is never entered nor stacked: the walk goes on with the other one
+            // (its interval trimmed as if the empty one had been visited), or with the stack.
+            const uint32_t first_empty = node->empty_child(!below_first), second_empty = node->empty_child(below_first);
             if (tp > t1 * kWidenUp || tp <= 0.f) {
                 node = first;
+                if (!first_empty) continue;
             } else if (tp < t0 * kWidenDown) {
                 node = second;
+                if (!second_empty) continue;
+            } else if (first_empty) {
+                node = second;
+                t0 = std::max(t0, tp * kWidenDown);
+                if (!second_empty) continue;
             } else {
-                stack[sp++] = {second, std::max(t0, tp * kWidenDown), t1};
+                if (!second_empty) stack[sp++] = {second, std::max(t0, tp * kWidenDown), t1};
                 node = first;
                 t1 = std::min(t1, tp * kWidenUp);
+                continue;
             }
-            continue;
-        }
-
+        } else {
         const uint32_t count = node->count();
         KD_COUNT(leaves, 1);
         KD_COUNT(tris, count);
@@ -591,12 +613,13 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         for (uint32_t i = 0; i < count; i += 4, ++b) {
             // Only the lanes that the 4-wide filter cannot reject go to the scalar test.
             const uint32_t n4 = std::min(count - i, 4u);
-            unsigned mask = triangle_filter4(r, *b, ray.tmin, ray.tmax) & ((1u << n4) - 1u);
+            unsigned mask = triangle_filter4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u);
             while (mask) {
                 const int k = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (test(*b, k) && Shadow) return true;
             }
+        }
         }
         // Next node in ray order, skipping those that start beyond the closest hit (with slack, so
         // that a hit within rounding of a boundary still meets the triangles beyond it). Entries
