@@ -507,11 +507,9 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
     if (!(t0 <= t1)) return false;
 
-    struct Todo {
-        const Node* node;
-        float t0, t1;
-    };
-    Todo stack[kMaxDepth + 4];
+    // The stack of nodes still to visit with their intervals, as three arrays: single stores.
+    const Node* st_node[kMaxDepth + 4];
+    float st_t0[kMaxDepth + 4], st_t1[kMaxDepth + 4];
     int sp = 0;
     const Node* nodes = nodes_.data();
     const Node* node = nodes;
@@ -542,7 +540,9 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             const __m128 tp = _mm_set_ss((split - oa) * r.inv_d[a]), vt1 = _mm_set_ss(t1);
             const __m128 ahead = _mm_cmpgt_ss(tp, zero);
             const __m128 push = _mm_and_ps(_mm_cmpnle_ss(tp, zero), _mm_cmpngt_ss(tp, _mm_mul_ss(vt1, up)));
-            stack[sp] = {below + (1 - above), _mm_cvtss_f32(_mm_max_ss(_mm_mul_ss(tp, down), zero)), t1};
+            st_node[sp] = below + (1 - above);
+            st_t0[sp] = _mm_cvtss_f32(_mm_max_ss(_mm_mul_ss(tp, down), zero));
+            st_t1[sp] = t1;
             sp += _mm_movemask_ps(push) & int(node->empty_child(1 - above) ^ 1u);
             t1 = _mm_cvtss_f32(_mm_min_ss(vt1, _mm_blendv_ps(inf, _mm_mul_ss(tp, up), ahead)));
             node = below + above;
@@ -581,7 +581,11 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
                 t0 = std::max(t0, tp * kWidenDown);
                 if (!second_empty) continue;
             } else {
-                if (!second_empty) stack[sp++] = {second, std::max(t0, tp * kWidenDown), t1};
+                if (!second_empty) {
+                    st_node[sp] = second;
+                    st_t0[sp] = std::max(t0, tp * kWidenDown);
+                    st_t1[sp++] = t1;
+                }
                 node = first;
                 t1 = std::min(t1, tp * kWidenUp);
                 continue;
@@ -627,11 +631,11 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         // interval starts before those pushed after it.
         for (;;) {
             if (sp == 0) return found;
-            const Todo& td = stack[--sp];
-            if (Shadow || !(tmax < td.t0 * kWidenDown)) {
-                node = td.node;
-                t0 = td.t0;
-                t1 = td.t1;
+            --sp;
+            if (Shadow || !(tmax < st_t0[sp] * kWidenDown)) {
+                node = st_node[sp];
+                t0 = st_t0[sp];
+                t1 = st_t1[sp];
                 break;
             }
         }
