@@ -451,15 +451,18 @@ struct RayData {
     }
 };
 
-// The rejection tests of intersect_triangle() (geometry/triangle.h) on four triangles at once: the
-// translation, the shear, the three edge functions, the determinant and the scaled distance, with the
-// same float operations in the same order (no FMA at -march=x86-64-v2), so each lane's values are
-// bit-identical to the scalar test's. Returns the lanes that test would not reject at its edge-sign
-// check or at its [tmin, tmax] check (any edge exactly 0 -- redone in double there -- or NaN counts
-// as not rejected); the caller runs the scalar test on those, so the filter decides nothing the
-// shared test would not. The distance check matters: a lane whose edges pass is a triangle the ray's
-// line crosses, often behind the origin or beyond the closest hit so far (the far wall of a room).
-inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes) {
+// intersect_triangle() (geometry/triangle.h) on four triangles at once: the translation, the
+// shear, the edge functions, the degenerate-triangle check, the determinant, the scaled distance
+// and its interval check, the division, and the error bound on t, with the same float operations
+// in the same order (no FMA at -march=x86-64-v2; max and abs written to give what std::max and
+// glm::abs give), so each lane's result is the scalar test's, bit for bit. Lanes with an edge
+// function exactly 0 are left to the scalar test itself (it redoes them in double): they come back
+// in `scalar`. The hits come back in the return value, with t, b1 and b2 in `out`.
+struct Hits4 {
+    alignas(16) float t[4], b1[4], b2[4];
+};
+inline unsigned triangle_hits4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes,
+                               unsigned& scalar, Hits4& out) {
     const __m128 sx = _mm_set1_ps(r.sx), sy = _mm_set1_ps(r.sy), sz = _mm_set1_ps(r.sz);
     __m128 x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
@@ -474,14 +477,26 @@ inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, fl
     const __m128 e0 = _mm_sub_ps(_mm_mul_ps(x[1], y[2]), _mm_mul_ps(y[1], x[2]));
     const __m128 e1 = _mm_sub_ps(_mm_mul_ps(x[2], y[0]), _mm_mul_ps(y[2], x[0]));
     const __m128 e2 = _mm_sub_ps(_mm_mul_ps(x[0], y[1]), _mm_mul_ps(y[0], x[1]));
-    // Edge test. With no edge exactly 0 (those are redone in double by the scalar test and never
-    // rejected here), "some edge negative and some positive" is "the sign bits differ". A NaN edge
-    // may go either way: the scalar test rejects NaN lanes too.
+    // Edge test. With no edge exactly 0, "some edge negative and some positive" is "the sign bits
+    // differ". A NaN edge may go either way: the scalar test rejects NaN lanes too (at t).
     const __m128 zero = _mm_setzero_ps();
     const __m128 any_zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero));
-    const __m128 signs_differ = _mm_or_ps(_mm_xor_ps(e0, e1), _mm_xor_ps(e0, e2));
-    const unsigned edge_out = unsigned(_mm_movemask_ps(_mm_andnot_ps(any_zero, signs_differ)));
-    if ((edge_out | ~lanes) == 15u) return 0;  // the usual case: the ray misses all four
+    const unsigned zero_edge = unsigned(_mm_movemask_ps(any_zero)) & lanes;
+    const unsigned edge_out = unsigned(_mm_movemask_ps(_mm_or_ps(_mm_xor_ps(e0, e1), _mm_xor_ps(e0, e2))));
+    scalar = zero_edge;
+    unsigned live = ~edge_out & lanes & ~zero_edge;
+    if (!live) return 0;  // the usual case: the ray misses all four
+    // Degenerate (collinear) triangles: n = cross(p1 - p0, p2 - p0) == 0, as glm::cross computes it.
+    __m128 u[3], w[3];
+    for (int a = 0; a < 3; ++a) {
+        const __m128 p0 = _mm_load_ps(b.v[0][a]);
+        u[a] = _mm_sub_ps(_mm_load_ps(b.v[1][a]), p0);
+        w[a] = _mm_sub_ps(_mm_load_ps(b.v[2][a]), p0);
+    }
+    const __m128 nx = _mm_sub_ps(_mm_mul_ps(u[1], w[2]), _mm_mul_ps(w[1], u[2]));
+    const __m128 ny = _mm_sub_ps(_mm_mul_ps(u[2], w[0]), _mm_mul_ps(w[2], u[0]));
+    const __m128 nz = _mm_sub_ps(_mm_mul_ps(u[0], w[1]), _mm_mul_ps(w[0], u[1]));
+    const __m128 degenerate = _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(nx, zero), _mm_cmpeq_ps(ny, zero)), _mm_cmpeq_ps(nz, zero));
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
     // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
     const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
@@ -489,9 +504,40 @@ inline unsigned triangle_filter4(const RayData& r, const KdTree::TriBlock& b, fl
     const __m128 lo = _mm_mul_ps(_mm_set1_ps(tmin), det), hi = _mm_mul_ps(_mm_set1_ps(tmax), det);
     const __m128 out_neg = _mm_and_ps(_mm_cmplt_ps(det, zero), _mm_or_ps(_mm_cmpge_ps(ts, lo), _mm_cmple_ps(ts, hi)));
     const __m128 out_pos = _mm_and_ps(_mm_cmpgt_ps(det, zero), _mm_or_ps(_mm_cmple_ps(ts, lo), _mm_cmpge_ps(ts, hi)));
-    // Rejected: t outside the interval (and no edge exactly 0), or by the edge test.
-    const unsigned t_out = unsigned(_mm_movemask_ps(_mm_andnot_ps(any_zero, _mm_or_ps(out_neg, out_pos))));
-    return ~(edge_out | t_out) & lanes;
+    __m128 rejected = _mm_or_ps(_mm_or_ps(degenerate, _mm_cmpeq_ps(det, zero)), _mm_or_ps(out_neg, out_pos));
+    live &= ~unsigned(_mm_movemask_ps(rejected));
+    if (!live) return 0;
+    const __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.f), det);
+    const __m128 t = _mm_mul_ps(ts, inv_det);
+    // !(t > tmin && t < tmax): rounding, and NaN from degenerate input.
+    rejected = _mm_or_ps(_mm_cmpngt_ps(t, _mm_set1_ps(tmin)), _mm_cmpnlt_ps(t, _mm_set1_ps(tmax)));
+    // t must exceed its rounding error bound (pbrt-v4); max(a, max(b, c)) as std::max nests it.
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    auto vabs = [&](__m128 v) { return _mm_and_ps(v, abs_mask); };
+    auto vmax3 = [&](__m128 a, __m128 b2, __m128 c) { return _mm_max_ps(_mm_max_ps(c, b2), a); };
+    const __m128 max_zt = vmax3(vabs(z[0]), vabs(z[1]), vabs(z[2]));
+    const __m128 max_xt = vmax3(vabs(x[0]), vabs(x[1]), vabs(x[2]));
+    const __m128 max_yt = vmax3(vabs(y[0]), vabs(y[1]), vabs(y[2]));
+    const __m128 delta_z = _mm_mul_ps(_mm_set1_ps(gamma_bound(3)), max_zt);
+    const __m128 delta_x = _mm_mul_ps(_mm_set1_ps(gamma_bound(5)), _mm_add_ps(max_xt, max_zt));
+    const __m128 delta_y = _mm_mul_ps(_mm_set1_ps(gamma_bound(5)), _mm_add_ps(max_yt, max_zt));
+    const __m128 delta_e = _mm_mul_ps(
+        _mm_set1_ps(2.f), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(gamma_bound(2)), max_xt), max_yt),
+                                                _mm_mul_ps(delta_y, max_xt)),
+                                     _mm_mul_ps(delta_x, max_yt)));
+    const __m128 max_e = vmax3(vabs(e0), vabs(e1), vabs(e2));
+    const __m128 delta_t = _mm_mul_ps(
+        _mm_mul_ps(_mm_set1_ps(3.f),
+                   _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(_mm_set1_ps(gamma_bound(3)), max_e), max_zt),
+                                         _mm_mul_ps(delta_e, max_zt)),
+                              _mm_mul_ps(delta_z, max_e))),
+        vabs(inv_det));
+    rejected = _mm_or_ps(rejected, _mm_cmple_ps(t, delta_t));
+    live &= ~unsigned(_mm_movemask_ps(rejected));
+    _mm_store_ps(out.t, t);
+    _mm_store_ps(out.b1, _mm_mul_ps(e1, inv_det));
+    _mm_store_ps(out.b2, _mm_mul_ps(e2, inv_det));
+    return live;
 }
 
 }  // namespace
@@ -615,13 +661,28 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         };
         const TriBlock* b = blocks_.data() + node->first;
         for (uint32_t i = 0; i < count; i += 4, ++b) {
-            // Only the lanes that the 4-wide filter cannot reject go to the scalar test.
             const uint32_t n4 = std::min(count - i, 4u);
-            unsigned mask = triangle_filter4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u);
-            while (mask) {
-                const int k = __builtin_ctz(mask);
-                mask &= mask - 1;
-                if (test(*b, k) && Shadow) return true;
+            unsigned scalar;
+            Hits4 h4;
+            unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
+            if (Shadow && hits) return true;
+            // In lane order, as the scalar test would meet them: a later lane replaces an earlier
+            // hit only when strictly closer.
+            for (unsigned m = hits | scalar; m; m &= m - 1) {
+                const int k = __builtin_ctz(m);
+                if (scalar >> k & 1u) {
+                    if (test(*b, k) && Shadow) return true;
+                } else if constexpr (!Shadow) {
+                    if (h4.t[k] < ray.tmax) {
+                        tmax = h4.t[k];
+                        ray.tmax = h4.t[k];
+                        hit->t = h4.t[k];
+                        hit->b1 = h4.b1[k];
+                        hit->b2 = h4.b2[k];
+                        hit->prim = b->prim[k];
+                        found = true;
+                    }
+                }
             }
         }
         }
