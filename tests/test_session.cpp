@@ -261,3 +261,32 @@ TEST(Session, RenderPriorityAppliesToTheWorker) {
         EXPECT_EQ(nice.load(), p == RenderPriority::Normal ? base_nice : 19) << render_priority_name(p);
     }
 }
+
+// What changes nothing in the image must not restart it: a thread-count change keeps the generation
+// and the passes accumulated so far, and the passes after it are the same samples as those of an
+// undisturbed render (the image does not depend on the thread count). (The viewer's display-only
+// controls, exposure and the panel, never reach the session at all.)
+TEST(Session, ThreadCountChangeDoesNotRestart) {
+    SessionOptions opt;
+    opt.threads = 2;
+    opt.spp_per_pass = 1;
+    opt.max_passes = 6;
+    RenderSession session(cornell(32, 24), opt);
+    ASSERT_TRUE(session.wait_for(0, 2, 60));
+    const uint64_t gen = session.stats().generation;
+    const int before = session.stats().passes;
+    session.set_threads(1);
+    ASSERT_TRUE(session.wait_for(gen, 6, 120));
+    EXPECT_EQ(session.stats().generation, gen);
+    EXPECT_GE(session.stats().passes, before);
+    SessionImage img = session.latest_full_image();
+    EXPECT_EQ(img.generation, gen);
+    EXPECT_EQ(img.passes, 6);
+
+    Film film(32, 24);
+    auto ref_scene = cornell(32, 24);
+    for (int p = 0; p < 6; ++p) Renderer::render_pass(*ref_scene, film, uint32_t(p), 1, 2);
+    std::vector<float> ref = film.resolve();
+    ASSERT_EQ(img.rgb.size(), ref.size());
+    for (size_t i = 0; i < ref.size(); ++i) ASSERT_EQ(img.rgb[i], ref[i]) << "at float " << i;
+}
