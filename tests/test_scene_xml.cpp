@@ -434,3 +434,92 @@ TEST(SceneXml, ErrorsInsideObjNameBothFiles) {
     EXPECT_NE(msg.find(obj + ":3: vertex has a NaN or infinite coordinate"), std::string::npos) << msg;
     EXPECT_NE(msg.find(path + ":3"), std::string::npos) << msg;
 }
+
+// The issue-5 plugins map Mitsuba's parameters and defaults onto the BSDFs.
+TEST(SceneXml, MaterialPluginsMapTheirParameters) {
+    std::string path = write_temp("materials.xml", scene_xml(
+        "<shape type=\"rectangle\"><bsdf type=\"conductor\"><rgb name=\"eta\" value=\"0.2 0.4 1.4\"/>"
+        "<rgb name=\"k\" value=\"3.9 2.4 1.8\"/><rgb name=\"specular_reflectance\" value=\"0.9\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/>"
+        "<float name=\"alpha\" value=\"0.25\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"plastic\"><rgb name=\"diffuse_reflectance\" value=\"0.1 0.2 0.3\"/>"
+        "<float name=\"int_ior\" value=\"1.6\"/><boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"ggx\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"dielectric\"><string name=\"int_ior\" value=\"diamond\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/>"
+        "<float name=\"alpha\" value=\"0.05\"/><float name=\"int_ior\" value=\"1.33\"/><float name=\"ext_ior\" value=\"1.1\"/>"
+        "<rgb name=\"specular_transmittance\" value=\"0.5\"/></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"twosided\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/></bsdf></bsdf></shape>\n"
+        "<shape type=\"rectangle\"><bsdf type=\"conductor\"/></shape>\n"));
+    Scene s = load_mitsuba_xml(path, {});
+    ASSERT_EQ(s.shapes.size(), 8u);
+    auto bsdf = [&](int shape) -> const Bsdf& { return s.materials[s.shapes[size_t(shape)].material].bsdf; };
+
+    const auto& c = std::get<ConductorBsdf>(bsdf(0));
+    expect_near(c.eta, vec3(0.2f, 0.4f, 1.4f));
+    expect_near(c.k, vec3(3.9f, 2.4f, 1.8f));
+    expect_near(c.specular_reflectance, vec3(0.9f));
+    EXPECT_EQ(c.alpha, 0.f);  // conductor: the ideal mirror
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(1)).alpha, 0.25f);
+
+    const auto& p = std::get<PlasticBsdf>(bsdf(2));
+    expect_near(p.diffuse_reflectance, vec3(0.1f, 0.2f, 0.3f));
+    EXPECT_FLOAT_EQ(p.int_ior, 1.6f);
+    EXPECT_FLOAT_EQ(p.ext_ior, 1.000277f);
+    EXPECT_TRUE(p.nonlinear);
+    EXPECT_EQ(p.alpha, 0.f);
+    const auto& rp = std::get<PlasticBsdf>(bsdf(3));  // Mitsuba's defaults
+    EXPECT_FLOAT_EQ(rp.alpha, 0.1f);
+    EXPECT_FLOAT_EQ(rp.int_ior, 1.49f);
+    expect_near(rp.diffuse_reflectance, vec3(0.5f));
+    EXPECT_FALSE(rp.nonlinear);
+
+    const auto& d = std::get<DielectricBsdf>(bsdf(4));
+    EXPECT_NEAR(d.int_ior, 2.419f, 1e-3f);  // Mitsuba's "diamond"
+    EXPECT_FLOAT_EQ(d.ext_ior, 1.000277f);
+    EXPECT_EQ(d.alpha, 0.f);
+    const auto& rd = std::get<DielectricBsdf>(bsdf(5));
+    EXPECT_FLOAT_EQ(rd.alpha, 0.05f);
+    EXPECT_FLOAT_EQ(rd.eta(), 1.33f / 1.1f);
+    expect_near(rd.specular_transmittance, vec3(0.5f));
+    expect_near(rd.specular_reflectance, vec3(1.f));
+
+    EXPECT_TRUE(s.materials[s.shapes[6].material].two_sided);
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(6)).alpha, 0.1f);
+    for (int i = 0; i < 6; ++i) EXPECT_FALSE(s.materials[s.shapes[size_t(i)].material].two_sided) << i;
+    const auto& c0 = std::get<ConductorBsdf>(bsdf(7));  // defaults: eta 0, k 1
+    expect_near(c0.eta, vec3(0.f));
+    expect_near(c0.k, vec3(1.f));
+}
+
+// Every scene the project ships loads, finalizes and names its materials' types as written.
+TEST(SceneXml, EveryShippedSceneLoads) {
+    const char* files[] = {"scenes/cornell-box/scene.xml", "scenes/veach-mis/scene.xml",
+                           "scenes/cornell-materials/mirror-glass.xml", "scenes/cornell-materials/rough.xml",
+                           "scenes/cornell-materials/glossy-glass.xml", "scenes/caustics/scene.xml"};
+    for (const char* f : files) {
+        Scene s = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/" + f, {{"res", "16"}, {"width", "16"}, {"height", "16"}});
+        EXPECT_NO_THROW(s.finalize()) << f;
+        EXPECT_GT(s.mesh.triangles.size(), 0u) << f;
+        EXPECT_FALSE(s.emitters.empty()) << f;
+        std::printf("  %s: %zu triangles, %zu materials, %zu emitters\n", f, s.mesh.triangles.size(), s.materials.size(),
+                    s.emitters.size());
+    }
+    // The caustics scene: a glass sphere (IOR 1.5) and a diamond (2.42), rough plates in Veach's.
+    Scene c = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/scenes/caustics/scene.xml", {});
+    std::vector<float> iors;
+    for (const Material& m : c.materials)
+        if (auto* d = std::get_if<DielectricBsdf>(&m.bsdf)) iors.push_back(d->eta());
+    std::sort(iors.begin(), iors.end());
+    ASSERT_EQ(iors.size(), 2u);
+    EXPECT_NEAR(iors[0], 1.5f, 0.01f);
+    EXPECT_NEAR(iors[1], 2.42f, 0.01f);
+    Scene v = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/scenes/veach-mis/scene.xml", {});
+    std::vector<float> alphas;
+    for (const Material& m : v.materials)
+        if (auto* k = std::get_if<ConductorBsdf>(&m.bsdf)) alphas.push_back(k->alpha);
+    std::sort(alphas.begin(), alphas.end());
+    ASSERT_EQ(alphas.size(), 4u);
+    EXPECT_FLOAT_EQ(alphas[0], 0.01f);
+    EXPECT_FLOAT_EQ(alphas[3], 0.2f);
+}
