@@ -19,7 +19,7 @@ struct ViewerBenchmark {
     int moves_per_burst = 1;    // consecutive frames that each change the camera (a "drag")
     bool paused = false;        // full passes paused: the window's own cost, previews only
     // Results.
-    std::vector<double> frame_ms;   // UI work per frame: events, panel, upload, draw, swap
+    std::vector<double> frame_ms;   // per frame, from the end of the event wait to the swap: events, panel, upload, draw, swap
     std::vector<double> frame_cpu_ms;  // the same, in CPU time of the window's thread: what the
                                        // frame costs on an idle core (with LP_NUM_THREADS=0 the
                                        // software rasteriser runs in this thread too)
