@@ -427,7 +427,7 @@ namespace {
 
 // Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
-    float o[3], d[3], inv_d[3];
+    float o[3], inv_d[3];
     bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
     // The origin as compared with split planes: o_above[a] > split exactly when the origin lies
     // above the plane, or on it moving up (o rounded up to the next float when d > 0).
@@ -443,7 +443,6 @@ struct RayData {
         sz = sh.sz;
         for (int i = 0; i < 3; ++i) {
             o[i] = ray.o[i];
-            d[i] = ray.d[i];
             inv_d[i] = 1.f / ray.d[i];
             d_nonpos[i] = ray.d[i] <= 0.f;
             o_above[i] = d_nonpos[i] ? o[i] : next_float_up(o[i]);
@@ -611,8 +610,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
             // for a ray lying in the plane, which then visits both children over the whole interval
             // (std::max / std::min return their first argument for a NaN second). Branches, not
-            // selects: a branch-free step measured the same on bounce rays and ~15% slower on
-            // (well predicted) primary rays.
+            // selects: a branch-free step measured 9% slower on bounce rays and much slower on
+            // (well predicted) primary rays (docs/accel.md).
             // An empty child is never entered nor stacked: the walk goes on with the other one
             // (its interval trimmed as if the empty one had been visited), or with the stack.
             const uint32_t first_empty = node->empty_child(!below_first), second_empty = node->empty_child(below_first);
@@ -637,54 +636,44 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
                 continue;
             }
         } else {
-        const uint32_t count = node->count();
-        KD_COUNT(leaves, 1);
-        KD_COUNT(tris, count);
-        // Tests one triangle with the shared watertight test itself, so that every hit is
-        // bit-identical to brute force.
-        auto test = [&](const TriBlock& b, int k) {
-            TriangleHit th;
-            const vec3 p0(b.v[0][0][k], b.v[0][1][k], b.v[0][2][k]);
-            const vec3 p1(b.v[1][0][k], b.v[1][1][k], b.v[1][2][k]);
-            const vec3 p2(b.v[2][0][k], b.v[2][1][k], b.v[2][2][k]);
-            if (!intersect_triangle(ray, sh, p0, p1, p2, th)) return false;
-            if constexpr (!Shadow) {
-                tmax = th.t;
-                ray.tmax = th.t;
-                hit->t = th.t;
-                hit->b1 = th.b1;
-                hit->b2 = th.b2;
-                hit->prim = b.prim[k];
+            const uint32_t count = node->count();
+            KD_COUNT(leaves, 1);
+            KD_COUNT(tris, count);
+            auto record = [&](float t, float b1, float b2, uint32_t prim) {
+                tmax = t;
+                ray.tmax = t;
+                hit->t = t;
+                hit->b1 = b1;
+                hit->b2 = b2;
+                hit->prim = prim;
                 found = true;
-            }
-            return true;
-        };
-        const TriBlock* b = blocks_.data() + node->first;
-        for (uint32_t i = 0; i < count; i += 4, ++b) {
-            const uint32_t n4 = std::min(count - i, 4u);
-            unsigned scalar;
-            Hits4 h4;
-            unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
-            if (Shadow && hits) return true;
-            // In lane order, as the scalar test would meet them: a later lane replaces an earlier
-            // hit only when strictly closer.
-            for (unsigned m = hits | scalar; m; m &= m - 1) {
-                const int k = __builtin_ctz(m);
-                if (scalar >> k & 1u) {
-                    if (test(*b, k) && Shadow) return true;
-                } else if constexpr (!Shadow) {
-                    if (h4.t[k] < ray.tmax) {
-                        tmax = h4.t[k];
-                        ray.tmax = h4.t[k];
-                        hit->t = h4.t[k];
-                        hit->b1 = h4.b1[k];
-                        hit->b2 = h4.b2[k];
-                        hit->prim = b->prim[k];
-                        found = true;
+            };
+            const TriBlock* b = blocks_.data() + node->first;
+            for (uint32_t i = 0; i < count; i += 4, ++b) {
+                const uint32_t n4 = std::min(count - i, 4u);
+                unsigned scalar;
+                Hits4 h4;
+                const unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
+                if (Shadow && hits) return true;
+                // In lane order, as the scalar test would meet them: a later lane replaces an
+                // earlier hit only when strictly closer. Lanes with an edge function exactly 0 go
+                // to the shared scalar test (its double fallback), so every hit is bit-identical
+                // to brute force.
+                for (unsigned m = hits | scalar; m; m &= m - 1) {
+                    const int k = __builtin_ctz(m);
+                    if (scalar >> k & 1u) {
+                        TriangleHit th;
+                        const vec3 p0(b->v[0][0][k], b->v[0][1][k], b->v[0][2][k]);
+                        const vec3 p1(b->v[1][0][k], b->v[1][1][k], b->v[1][2][k]);
+                        const vec3 p2(b->v[2][0][k], b->v[2][1][k], b->v[2][2][k]);
+                        if (!intersect_triangle(ray, sh, p0, p1, p2, th)) continue;
+                        if constexpr (Shadow) return true;
+                        record(th.t, th.b1, th.b2, b->prim[k]);
+                    } else if constexpr (!Shadow) {
+                        if (h4.t[k] < ray.tmax) record(h4.t[k], h4.b1[k], h4.b2[k], b->prim[k]);
                     }
                 }
             }
-        }
         }
         // Next node in ray order, skipping those that start beyond the closest hit (with slack, so
         // that a hit within rounding of a boundary still meets the triangles beyond it). Entries
