@@ -349,7 +349,7 @@ TEST(KdTree, CoherentOriginsMatchBruteForce) {
         if (load_obj(shared_mesh(name), m)) meshes.emplace_back(name, std::move(m));
     }
     for (const auto& [what, m] : meshes) {
-        const std::vector<Ray> rays = make_coherent_rays(m, m.triangles.size() > 20000 ? 4000 : 20000, 11);
+        const std::vector<Ray> rays = make_coherent_rays(m, m.triangles.size() > 20000 ? 2000 : 20000, 11);
         const Reference ref = brute_force(m, rays);
         KdTreeAccel kd(m);
         // Odd rays are aimed at a vertex, where several triangles are hit within an ulp or two of
