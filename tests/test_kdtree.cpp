@@ -213,8 +213,7 @@ void expect_matches(const Accel& acc, const Mesh& m, const std::vector<Ray>& ray
 
 // Rays as a path tracer makes them (and neighbouring pixels do): runs of rays from one surface point
 // or from points a little apart, in random directions or aimed at the mesh's vertices (which lie on
-// split planes, often on several at once). They start from the k-d tree's cached origin leaf or its
-// ancestor, and cross leaves through edges and corners.
+// split planes, often on several at once), so that they cross leaves through edges and corners.
 std::vector<Ray> make_coherent_rays(const Mesh& m, size_t n, uint64_t seed) {
     PCG32 rng(seed, 7);
     const AABB b = m.bounds();
@@ -341,7 +340,8 @@ TEST(KdTree, DragonMatchesBruteForce) {
 }
 
 TEST(KdTree, CoherentOriginsMatchBruteForce) {
-    // The origin cache and the ropes' edge and corner fallback, on a soup and on the scanned meshes.
+    // Runs of rays from shared origins, many through vertices on split planes, on a soup and on the
+    // scanned meshes.
     std::vector<std::pair<std::string, Mesh>> meshes;
     meshes.emplace_back("random soup", random_soup(3000, 5));
     for (const char* name : {"bunny.obj", "dragon_100k.obj"}) {
@@ -382,41 +382,6 @@ TEST(KdTree, CoherentOriginsMatchBruteForce) {
         EXPECT_EQ(bad, 0u) << what << ": coherent rays differing from brute force";
         EXPECT_LT(ties, rays.size() / 10) << what << ": rounding ties at vertices";
         std::printf("%s: %zu coherent rays, %zu vertex ties within 4 ulps\n", what.c_str(), rays.size(), ties);
-    }
-}
-
-TEST(KdTree, OriginCacheTellsTreesApart) {
-    // Two trees traced in turn from the same points: each ray must meet its own tree's triangles,
-    // never start from the other tree's cached leaf.
-    const Mesh a = random_soup(2000, 21), b = random_soup(2000, 22);
-    KdTreeAccel ka(a), kb(b);
-    BruteForceAccel ba(a), bb(b);
-    const std::vector<Ray> rays = make_coherent_rays(a, 4000, 23);
-    size_t bad = 0;
-    for (const Ray& ray : rays) {
-        for (int k = 0; k < 2; ++k) {
-            const KdTreeAccel& kd = k == 0 ? ka : kb;
-            const BruteForceAccel& br = k == 0 ? ba : bb;
-            Ray r1 = ray, r2 = ray;
-            Hit h1, h2;
-            const bool hit1 = kd.intersect(r1, h1), hit2 = br.intersect(r2, h2);
-            bad += hit1 != hit2 || (hit1 && h1.t != h2.t) || kd.occluded(ray) != hit2;
-        }
-    }
-    EXPECT_EQ(bad, 0u);
-    // A tree built again in the same place is a new tree to the cache.
-    Mesh c = random_soup(2000, 24);
-    for (int round = 0; round < 2; ++round) {
-        KdTreeAccel kc(round == 0 ? a : c);
-        BruteForceAccel bc(round == 0 ? a : c);
-        size_t wrong = 0;
-        for (const Ray& ray : rays) {
-            Ray r1 = ray, r2 = ray;
-            Hit h1, h2;
-            const bool hit1 = kc.intersect(r1, h1), hit2 = bc.intersect(r2, h2);
-            wrong += hit1 != hit2 || (hit1 && h1.t != h2.t);
-        }
-        EXPECT_EQ(wrong, 0u) << "round " << round;
     }
 }
 

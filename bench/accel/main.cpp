@@ -399,13 +399,9 @@ int main(int argc, char** argv) try {
                 std::fprintf(stderr, "[%s] %.3f Mrays/s per second of thread CPU time\n", name.c_str(), r.cpu_mrays);
 #ifdef CANDELA_KD_COUNTERS
             if (const KdTraceCounters& c = counters[k]; c.rays > 0)
-                std::fprintf(stderr,
-                             "[%s] per ray: %.2f nodes (%.2f on the way down from the root), %.2f leaves, %.2f "
-                             "triangle tests; %.1f%% started from the cached origin leaf, %.3f%% handed to the "
-                             "stack at an edge or corner (1 thread only)\n",
-                             name.c_str(), double(c.nodes) / double(c.rays), double(c.walk) / double(c.rays),
-                             double(c.leaves) / double(c.rays), double(c.tris) / double(c.rays),
-                             100.0 * double(c.cached) / double(c.rays), 100.0 * double(c.rope_fallbacks) / double(c.rays));
+                std::fprintf(stderr, "[%s] per ray: %.2f nodes, %.2f leaves, %.2f triangle tests (1 thread only)\n",
+                             name.c_str(), double(c.nodes) / double(c.rays), double(c.leaves) / double(c.rays),
+                             double(c.tris) / double(c.rays));
 #endif
             std::printf("accel=%s rays=%zu hits=%llu sum_t=%.9e build_s=%.4f mrays_per_s=%.3f\n", name.c_str(),
                         rays.size(), (unsigned long long)r.hits, r.sum_t, built[k].build_s, r.mrays);
@@ -467,12 +463,9 @@ int main(int argc, char** argv) try {
             Result c1 = trace(*b.accel, rays, false, 1, repeat);
 #ifdef CANDELA_KD_COUNTERS
             if (const KdTraceCounters& c = kd_trace_counters(); c.rays > 0)
-                std::fprintf(stderr,
-                             "[%s %s closest] per ray: %.2f nodes (%.2f on the way down from the root), %.2f "
-                             "leaves, %.2f triangle tests; %.1f%% from the cached origin leaf\n",
+                std::fprintf(stderr, "[%s %s closest] per ray: %.2f nodes, %.2f leaves, %.2f triangle tests\n",
                              name.c_str(), set == 0 ? "primary" : "bounce", double(c.nodes) / double(c.rays),
-                             double(c.walk) / double(c.rays), double(c.leaves) / double(c.rays),
-                             double(c.tris) / double(c.rays), 100.0 * double(c.cached) / double(c.rays));
+                             double(c.leaves) / double(c.rays), double(c.tris) / double(c.rays));
 #endif
             Result cn = trace(*b.accel, rays, false, nthreads, repeat);
             Result a1 = trace(*b.accel, rays, true, 1, repeat);

@@ -2,9 +2,7 @@
 #include <omp.h>
 #include <immintrin.h>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstring>
 #include <memory>
 #include "core/error.h"
 #include "geometry/triangle.h"
@@ -269,26 +267,11 @@ constexpr float kWidenDown = 1.f - 1.f / 65536.f;
 
 }  // namespace
 
-namespace {
-std::atomic<uint64_t> g_next_tree_id{1};
-// The leaf where this thread's last ray from inside a tree started, and that tree.
-struct OriginCache {
-    uint64_t tree = 0;  // KdTree::id_
-    uint32_t at = 0;    // the leaf's link
-    float lo[3] = {}, hi[3] = {};
-};
-OriginCache& origin_cache() {
-    static thread_local OriginCache c;
-    return c;
-}
-}  // namespace
-
 // ---- KdTree ---------------------------------------------------------------------------------
 
 void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AABB* clip, const KdBuildOptions& opt) {
     nodes_.clear();
     blocks_.clear();
-    lines_.clear();
     bounds_ = AABB();
     stats_ = {};
 
@@ -366,7 +349,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
             Node& nd = t.nodes_[idx];
             if (bn->axis >= 0) {
-                nd.split = bn->split + 0.f;  // -0 -> +0: the walk compares splits as ordered integers
+                nd.split = bn->split;
                 nd.bits = uint32_t(bn->axis);
                 return;
             }
@@ -421,99 +404,12 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     };
     Flatten{*this, mesh, list}.run(*root);
     nodes_.shrink_to_fit();
+    blocks_.shrink_to_fit();
     stats_.nodes = nodes_.size();
-    build_ropes();
-    blocks_ = {};
-    id_ = g_next_tree_id.fetch_add(1);
-}
-
-// Ropes top down: a node's ropes are its parent's, with the face on the parent's split plane
-// pointing at the sibling; then each rope is pushed down its target's subtree while one child
-// holds the whole face (the child next to the face when the target splits the face's axis, the
-// child on the face's side of a plane that misses the face). A ray leaving a leaf through a face
-// then enters the node its rope names and goes down from there, in a few steps.
-void KdTree::build_ropes() {
-    std::vector<Unit> leaves;
-    constexpr size_t kLinkUnits = sizeof(Link) / sizeof(Unit), kBlockUnits = sizeof(TriBlock) / sizeof(Unit);
-    static_assert(sizeof(Link) % sizeof(Unit) == 0 && sizeof(TriBlock) % sizeof(Unit) == 0, "whole units");
-    leaves.reserve(stats_.leaves * kLinkUnits + blocks_.size() * kBlockUnits + stats_.leaves);
-    struct Item {
-        uint32_t node;
-        float lo[3], hi[3];
-        uint32_t rope[6];
-    };
-    std::vector<Item> stack;
-    std::vector<uint32_t> link_at;
-    Item root{0, {bounds_.min.x, bounds_.min.y, bounds_.min.z}, {bounds_.max.x, bounds_.max.y, bounds_.max.z}, {}};
-    for (uint32_t& r : root.rope) r = kNoRope;
-    stack.push_back(root);
-    while (!stack.empty()) {
-        Item it = stack.back();
-        stack.pop_back();
-        for (int f = 0; f < 6; ++f) {
-            const int fa = f >> 1, side = f & 1;
-            uint32_t r = it.rope[f];
-            while (r != kNoRope && !nodes_[r].leaf()) {
-                const Node& n = nodes_[r];
-                const int b = n.axis();
-                if (b == fa) r = n.children() + uint32_t(side == 0);  // beyond max: the below child
-                else if (n.split >= it.hi[b]) r = n.children();
-                else if (n.split <= it.lo[b]) r = n.children() + 1;
-                else break;
-            }
-            it.rope[f] = r;
-        }
-        Node& nd = nodes_[it.node];
-        if (nd.leaf()) {
-            Link l{};
-            for (int a = 0; a < 3; ++a) {
-                l.box[a] = it.lo[a];
-                l.box[4 + a] = it.hi[a];
-            }
-            for (int f = 0; f < 6; ++f) l.rope[f] = it.rope[f];
-            l.count = nd.count();
-            if (leaves.size() % 2) leaves.emplace_back();  // each leaf on a 64-byte line
-            if (leaves.size() + kLinkUnits + (nd.count() + 3) / 4 * kBlockUnits >= kRopeLeaf)
-                throw Error("k-d tree: more than 64 GB of leaves");
-            const uint32_t at = uint32_t(leaves.size());
-            leaves.resize(leaves.size() + kLinkUnits);
-            std::memcpy(static_cast<void*>(leaves.data() + at), &l, sizeof(Link));
-            const size_t nb = (size_t(nd.count()) + 3) / 4;
-            if (nb > 0) {
-                const size_t b0 = leaves.size();
-                leaves.resize(b0 + nb * kBlockUnits);
-                std::memcpy(static_cast<void*>(leaves.data() + b0), blocks_.data() + nd.first, nb * sizeof(TriBlock));
-            }
-            nd.first = at;
-            link_at.push_back(at);
-            continue;
-        }
-        const int a = nd.axis();
-        const uint32_t c = nd.children();
-        Item below = it, above = it;
-        below.node = c;
-        below.hi[a] = nd.split;
-        below.rope[2 * a + 1] = c + 1;
-        above.node = c + 1;
-        above.lo[a] = nd.split;
-        above.rope[2 * a] = c;
-        stack.push_back(above);
-        stack.push_back(below);
-    }
-    // Ropes to leaves name their links, now that every leaf has its place.
-    for (uint32_t at : link_at) {
-        Link l;
-        std::memcpy(&l, leaves.data() + at, sizeof(Link));
-        for (uint32_t& r : l.rope)
-            if (r != kNoRope && nodes_[r].leaf()) r = kRopeLeaf | nodes_[r].first;
-        std::memcpy(static_cast<void*>(leaves.data() + at), &l, sizeof(Link));
-    }
-    lines_.assign((leaves.size() + 1) / 2, Line{});
-    if (!leaves.empty()) std::memcpy(static_cast<void*>(lines_.data()), leaves.data(), leaves.size() * sizeof(Unit));
 }
 
 size_t KdTree::memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + lines_.capacity() * sizeof(Line);
+    return nodes_.capacity() * sizeof(Node) + blocks_.capacity() * sizeof(TriBlock);
 }
 
 KdTraceCounters& kd_trace_counters() {
@@ -529,14 +425,6 @@ KdTraceCounters& kd_trace_counters() {
 
 namespace {
 
-// A float's bits as a signed integer that orders like the float (for finite values, and with -0
-// normalised to +0 by the caller): negative floats have their magnitude bits flipped.
-inline int32_t float_key(float f) {
-    int32_t i;
-    std::memcpy(&i, &f, 4);
-    return i ^ ((i >> 31) & 0x7fffffff);
-}
-
 // Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
     float o[3], inv_d[3];
@@ -544,13 +432,6 @@ struct RayData {
     // The origin as compared with split planes: o_above[a] > split exactly when the origin lies
     // above the plane, or on it moving up (o rounded up to the next float when d > 0).
     float o_above[3];
-    // o_above as ordered integers (float_key): the walk from the root compares them with the
-    // splits in integer registers, selected by the node's axis without a load.
-    int32_t k_above[3];
-    // Rope traversal (no direction component 0 or subnormal): per axis, the index of the exit
-    // plane in Link::box and of the exit face's rope.
-    bool ropes;
-    uint32_t far[3], slot[3];
     int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide filter
     float sx, sy, sz;
     RayData(const Ray& ray, const RayShear& sh) {
@@ -565,11 +446,7 @@ struct RayData {
             inv_d[i] = 1.f / ray.d[i];
             d_nonpos[i] = ray.d[i] <= 0.f;
             o_above[i] = d_nonpos[i] ? o[i] : next_float_up(o[i]);
-            k_above[i] = float_key(o_above[i] + 0.f);
-            far[i] = uint32_t(i) + (d_nonpos[i] ? 0u : 4u);
-            slot[i] = 2u * uint32_t(i) + (d_nonpos[i] ? 0u : 1u);
         }
-        ropes = std::isfinite(inv_d[0]) && std::isfinite(inv_d[1]) && std::isfinite(inv_d[2]);
     }
 };
 
@@ -670,159 +547,19 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
     KD_COUNT(rays, 1);
     const RayShear sh(ray.d);
     const RayData r(ray, sh);
-    const Node* nodes = nodes_.data();
-    const Node* node = nodes;
-    bool found = false;
-    // Tests a leaf's triangles against (ray.tmin, ray.tmax), shrinking ray.tmax; for Shadow, true
-    // on the first hit.
-    auto test_leaf = [&](uint32_t at, uint32_t count) __attribute__((always_inline)) -> bool {
-        KD_COUNT(leaves, 1);
-        KD_COUNT(tris, count);
-        auto record = [&](float t, float b1, float b2, uint32_t prim) {
-            ray.tmax = t;
-            hit->t = t;
-            hit->b1 = b1;
-            hit->b2 = b2;
-            hit->prim = prim;
-            found = true;
-        };
-        const TriBlock* b = blocks(at);
-        for (uint32_t i = 0; i < count; i += 4, ++b) {
-            const uint32_t n4 = std::min(count - i, 4u);
-            unsigned scalar;
-            Hits4 h4;
-            const unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
-            if (Shadow && hits) return true;
-            // In lane order, as the scalar test would meet them: a later lane replaces an
-            // earlier hit only when strictly closer. Lanes with an edge function exactly 0 go
-            // to the shared scalar test (its double fallback), so every hit is bit-identical
-            // to brute force.
-            for (unsigned m = hits | scalar; m; m &= m - 1) {
-                const int k = __builtin_ctz(m);
-                if (scalar >> k & 1u) {
-                    TriangleHit th;
-                    const vec3 p0(b->v[0][0][k], b->v[0][1][k], b->v[0][2][k]);
-                    const vec3 p1(b->v[1][0][k], b->v[1][1][k], b->v[1][2][k]);
-                    const vec3 p2(b->v[2][0][k], b->v[2][1][k], b->v[2][2][k]);
-                    if (!intersect_triangle(ray, sh, p0, p1, p2, th)) continue;
-                    if constexpr (Shadow) return true;
-                    record(th.t, th.b1, th.b2, b->prim[k]);
-                } else if constexpr (!Shadow) {
-                    if (h4.t[k] < ray.tmax) record(h4.t[k], h4.b1[k], h4.b2[k], b->prim[k]);
-                }
-            }
-        }
-        return false;
-    };
-    // On which side of a node's plane the origin lies, as ordered integers (r.o_above[a] > split,
-    // see RayData): the axis selects the key with masks instead of a load (or a branch, which GCC
-    // makes of a ?:), shortening the dependent chain from one node to the next.
-    auto origin_above = [&](uint32_t bits, float split) -> uint32_t {
-        const int32_t m1 = -int32_t(bits & 1u), m2 = -int32_t((bits >> 1) & 1u);  // axis 1, axis 2
-        const int32_t ko = r.k_above[0] ^ ((r.k_above[0] ^ r.k_above[1]) & m1) ^ ((r.k_above[0] ^ r.k_above[2]) & m2);
-        return uint32_t(ko > float_key(split));
-    };
+    float t0, t1;
+    if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
+    t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
+    if (!(t0 <= t1)) return false;
 
-    // A ray starting strictly inside the leaf where this thread's last ray from inside this tree
-    // started starts there too, without the walk from the root (the leaf is then the only one
-    // holding the origin, whatever the direction). The shadow ray and the next bounce ray of a
-    // path vertex leave from one point, and neighbouring pixels' bounce rays from one leaf.
-    OriginCache& oc = origin_cache();
-    const bool cached = r.ropes && oc.tree == id_ && r.o[0] > oc.lo[0] && r.o[0] < oc.hi[0] && r.o[1] > oc.lo[1] &&
-                        r.o[1] < oc.hi[1] && r.o[2] > oc.lo[2] && r.o[2] < oc.hi[2];
-    float t0 = 0.f, t1 = 0.f;
-    if (!cached) {
-        if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
-        t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
-        if (!(t0 <= t1)) return false;
-    }
-
-    if (cached) {
-        // Rope traversal from the cached leaf: bounce and shadow rays that leave from the leaf
-        // where the thread's previous such ray left. Rays without a cached leaf take the stack
-        // traversal below, which is faster than ropes when it has to walk down from the root
-        // anyway (ropes from a walked leaf measured 19% slower on bounce rays in random order:
-        // each leaf crossed is a 64-byte link that is rarely in cache).
-        // The ray's position is its parameter t: it is beyond a plane once t reaches
-        // tp = (split - o) / d, computed as everywhere else in the tree, so the leaf it is in at
-        // any t is well defined, and a leaf's exit (its nearest far face) is one of those tp.
-        // Going down from a rope, the child is the origin's side unless the ray has crossed the
-        // plane by t_entry (0 < tp <= t_entry). Each rope crosses a face in the direction of
-        // travel, so no leaf is visited twice and the walk ends. Where two planes meet within
-        // rounding of the ray (an edge or a corner) the ray hands over to the stack traversal.
-        KD_COUNT(cached, 1);
-        uint32_t at = oc.at;  // the current leaf's Link
-        float t_entry = 0.f;
-        for (;;) {
-            const Link& l = link(at);
-            // The exit: the far face reached first (far faces only: no direction component is 0).
-            const float tx = (l.box[r.far[0]] - r.o[0]) * r.inv_d[0];
-            const float ty = (l.box[r.far[1]] - r.o[1]) * r.inv_d[1];
-            const float tz = (l.box[r.far[2]] - r.o[2]) * r.inv_d[2];
-            // argmin with masks, not branches
-            const uint32_t my = -uint32_t(ty < tx);
-            const float txy = std::min(ty, tx);
-            uint32_t slot = r.slot[0] ^ ((r.slot[0] ^ r.slot[1]) & my);
-            const uint32_t mz = -uint32_t(tz < txy);
-            slot ^= (slot ^ r.slot[2]) & mz;
-            const float t_exit = std::min(tz, txy);
-            // Two faces within rounding of each other: the ray leaves through an edge or a corner,
-            // where the leaves it only touches may hold the one triangle that reports a hit at
-            // a shared vertex or edge (watertightness). The stack traversal, whose intervals are
-            // widened, takes over from there.
-            const float near_exit = t_exit * kWidenUp;
-            const bool corner = int(tx <= near_exit) + int(ty <= near_exit) + int(tz <= near_exit) > 1;
-            if (l.count != 0 && test_leaf(at, l.count)) return true;
-            // The closest hit so far (or the segment's end) lies before the next leaf, with slack
-            // for hits within rounding of the face.
-            if (ray.tmax < t_exit * kWidenDown) return found;
-            if (corner) {
-                t0 = t_exit * kWidenDown;
-                break;
-            }
-            const uint32_t next = l.rope[slot];
-            if (next == kNoRope) return found;
-            t_entry = std::max(t_entry, t_exit);
-            if (next & kRopeLeaf) {
-                at = next & ~kRopeLeaf;
-                continue;
-            }
-            // Down from the rope's node; a plane within rounding of the entry point is the same
-            // edge case as above.
-            const float near_lo = t_entry * kWidenDown, near_hi = t_entry * kWidenUp;
-            uint32_t near_plane = 0;
-            for (node = nodes + next; !node->leaf();) {
-                KD_COUNT(nodes, 1);
-                const uint32_t bits = node->bits;
-                const int a = int(bits & 3u);
-                const float split = node->split;
-                const float tp = (split - r.o[a]) * r.inv_d[a];
-                const uint32_t crossed = uint32_t(tp > 0.f) & uint32_t(tp <= t_entry);
-                near_plane |= uint32_t(tp >= near_lo) & uint32_t(tp <= near_hi);
-                node = nodes + (bits >> 4) + (origin_above(bits, split) ^ crossed);
-            }
-            if (near_plane) {
-                t0 = near_lo;
-                break;
-            }
-            at = node->first;
-        }
-        // The stack traversal from t0 on (every leaf before it has been tested), to the end of
-        // the root box.
-        KD_COUNT(rope_fallbacks, 1);
-        float b0;
-        if (!bounds_.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), b0, t1)) return found;
-        node = nodes;
-    }
-
-    // Stack traversal, for rays without a cached leaf (rays from outside the tree, rays whose
-    // origin is not where the last one's was, rays with a direction component 0, which can lie
-    // in a split plane and must then visit both sides) and for the rest of a rope traversal that
-    // met an edge or a corner.
     // The stack of nodes still to visit with their intervals, as three arrays: single stores.
     const Node* st_node[kMaxDepth + 4];
     float st_t0[kMaxDepth + 4], st_t1[kMaxDepth + 4];
     int sp = 0;
+    const Node* nodes = nodes_.data();
+    const Node* node = nodes;
+    float tmax = ray.tmax;
+    bool found = false;
     if (t0 == 0.f) {
         // The segment starts at the origin (inside the root box): every node on the way down
         // holds the origin, so the next node is always the child on the origin's side (the exact
@@ -835,36 +572,25 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         const __m128 inf = _mm_set_ss(kInfinity);
         while (!node->leaf()) {
             KD_COUNT(nodes, 1);
-            KD_COUNT(walk, 1);
-            const uint32_t bits = node->bits;
-            const int a = int(bits & 3u);
+            const int a = node->axis();
             const float split = node->split;
-            const uint32_t above = origin_above(bits, split);
-            const Node* below = nodes + (bits >> 4);
+            const float oa = r.o[a];
+            const int above = int(r.o_above[a] > split);
+            const Node* below = nodes + node->children();
             // Pushed unless the plane is behind (tp <= 0) or beyond the segment; a NaN tp (the
             // ray lies in the plane) pushes over the whole segment (max_ss returns its second
             // operand for a NaN). The segment's end is a running minimum over the planes ahead
             // (min(t1, tp) when tp > 0, which leaves t1 alone where nothing was pushed), so its
             // update does not wait for the push decision.
-            const __m128 tp = _mm_set_ss((split - r.o[a]) * r.inv_d[a]), vt1 = _mm_set_ss(t1);
+            const __m128 tp = _mm_set_ss((split - oa) * r.inv_d[a]), vt1 = _mm_set_ss(t1);
             const __m128 ahead = _mm_cmpgt_ss(tp, zero);
             const __m128 push = _mm_and_ps(_mm_cmpnle_ss(tp, zero), _mm_cmpngt_ss(tp, _mm_mul_ss(vt1, up)));
             st_node[sp] = below + (1 - above);
             st_t0[sp] = _mm_cvtss_f32(_mm_max_ss(_mm_mul_ss(tp, down), zero));
             st_t1[sp] = t1;
-            sp += _mm_movemask_ps(push) & int(((bits >> (3 - above)) & 1u) ^ 1u);  // the far child is not empty
+            sp += _mm_movemask_ps(push) & int(node->empty_child(1 - above) ^ 1u);
             t1 = _mm_cvtss_f32(_mm_min_ss(vt1, _mm_blendv_ps(inf, _mm_mul_ss(tp, up), ahead)));
             node = below + above;
-        }
-        // The leaf holding the origin, for the next ray from nearby.
-        if (r.ropes) {
-            const Link& l = link(node->first);
-            oc.tree = id_;
-            oc.at = node->first;
-            for (int a = 0; a < 3; ++a) {
-                oc.lo[a] = l.box[a];
-                oc.hi[a] = l.box[4 + a];
-            }
         }
     }
     for (;;) {
@@ -909,8 +635,45 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
                 t1 = std::min(t1, tp * kWidenUp);
                 continue;
             }
-        } else if (test_leaf(node->first, node->count())) {
-            return true;
+        } else {
+            const uint32_t count = node->count();
+            KD_COUNT(leaves, 1);
+            KD_COUNT(tris, count);
+            auto record = [&](float t, float b1, float b2, uint32_t prim) {
+                tmax = t;
+                ray.tmax = t;
+                hit->t = t;
+                hit->b1 = b1;
+                hit->b2 = b2;
+                hit->prim = prim;
+                found = true;
+            };
+            const TriBlock* b = blocks_.data() + node->first;
+            for (uint32_t i = 0; i < count; i += 4, ++b) {
+                const uint32_t n4 = std::min(count - i, 4u);
+                unsigned scalar;
+                Hits4 h4;
+                const unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
+                if (Shadow && hits) return true;
+                // In lane order, as the scalar test would meet them: a later lane replaces an
+                // earlier hit only when strictly closer. Lanes with an edge function exactly 0 go
+                // to the shared scalar test (its double fallback), so every hit is bit-identical
+                // to brute force.
+                for (unsigned m = hits | scalar; m; m &= m - 1) {
+                    const int k = __builtin_ctz(m);
+                    if (scalar >> k & 1u) {
+                        TriangleHit th;
+                        const vec3 p0(b->v[0][0][k], b->v[0][1][k], b->v[0][2][k]);
+                        const vec3 p1(b->v[1][0][k], b->v[1][1][k], b->v[1][2][k]);
+                        const vec3 p2(b->v[2][0][k], b->v[2][1][k], b->v[2][2][k]);
+                        if (!intersect_triangle(ray, sh, p0, p1, p2, th)) continue;
+                        if constexpr (Shadow) return true;
+                        record(th.t, th.b1, th.b2, b->prim[k]);
+                    } else if constexpr (!Shadow) {
+                        if (h4.t[k] < ray.tmax) record(h4.t[k], h4.b1[k], h4.b2[k], b->prim[k]);
+                    }
+                }
+            }
         }
         // Next node in ray order, skipping those that start beyond the closest hit (with slack, so
         // that a hit within rounding of a boundary still meets the triangles beyond it). Entries
@@ -919,7 +682,7 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         for (;;) {
             if (sp == 0) return found;
             --sp;
-            if (Shadow || !(ray.tmax < st_t0[sp] * kWidenDown)) {
+            if (Shadow || !(tmax < st_t0[sp] * kWidenDown)) {
                 node = st_node[sp];
                 t0 = st_t0[sp];
                 t1 = st_t1[sp];

@@ -7,11 +7,7 @@
 // splits it into the children's lists without re-sorting (only the few straddling triangles are
 // clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
 //
-// Traversal: 8-byte nodes. Rays that start inside the tree (bounce and shadow rays) go from leaf
-// to leaf by ropes, starting from the leaf where the thread's previous such ray started when the
-// origin lies inside it; rays from outside, rays with a zero direction component and rays that
-// leave a leaf through an edge or corner use a fixed-size stack. template <bool Shadow> gives the
-// any-hit variant.
+// Traversal: 8-byte nodes, a fixed-size stack, template <bool Shadow> for the any-hit variant.
 // Leaves hold their triangles' vertices in blocks of four, laid out for the 4-wide filter (a copy
 // per leaf reference). Every triangle test
 // is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the same t,
@@ -45,9 +41,6 @@ struct KdTreeStats {
 // benchmark prints them per ray). Without the flag they stay zero and cost nothing.
 struct KdTraceCounters {
     uint64_t rays = 0, nodes = 0, leaves = 0, tris = 0;
-    uint64_t walk = 0;            // nodes on the way down from the root to the origin's leaf
-    uint64_t cached = 0;          // rays that started from the cached origin leaf
-    uint64_t rope_fallbacks = 0;  // rope traversals handed to the stack at an edge or a corner
 };
 KdTraceCounters& kd_trace_counters();
 
@@ -75,7 +68,7 @@ public:
 
     // Compact node: an interior node keeps the split position and the index of its first child
     // ("below" the plane; the "above" child follows it: siblings are adjacent). A leaf keeps its
-    // triangle count and `first`, where its Link and TriBlocks start in lines_ (in 32-byte units).
+    // triangle count and `first`, the index of its first TriBlock.
     struct Node {
         union {
             float split;
@@ -95,23 +88,6 @@ public:
     };
     static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
 
-    // A leaf's box and its ropes (Havran's rope trees; Popov et al. 2007): for each face, the
-    // smallest node that holds the whole face on the other side (kNoRope where the face is on the
-    // root box). A ray leaves a leaf through the face it reaches first and goes down from that
-    // node to the next leaf along the ray, without a stack and without returning to the root.
-    // A rope to a leaf names the leaf's Link itself (kRopeLeaf | its offset), so the ray goes
-    // from link to link without loading the node. One cache line per leaf, empty leaves
-    // included, followed by the leaf's TriBlocks: the two come in one trip to memory, not two
-    // dependent ones.
-    static constexpr uint32_t kNoRope = 0xffffffffu, kRopeLeaf = 0x80000000u;
-    struct alignas(64) Link {
-        float box[8];      // min x y z, 0, max x y z, 0: box[a + 4 * (d[a] > 0)] is the exit plane
-        uint32_t rope[6];  // face 2 * axis + side (0 the min face, 1 the max face)
-        uint32_t count;    // triangles
-        uint32_t pad;
-    };
-    static_assert(sizeof(Link) == 64, "a link is one cache line");
-
     // Four triangles of a leaf, vertex coordinates by axis and lane (v[vertex][axis][lane]), so
     // that the 4-wide filter loads them as they are; a leaf holds ceil(count / 4) blocks, the last
     // lane repeated to fill the last one.
@@ -124,27 +100,11 @@ public:
 private:
     template <bool Shadow>
     bool trace(Ray& ray, Hit* hit) const;
-    void build_ropes();
 
     std::vector<Node> nodes_;
-    // The leaves, each a Link then its TriBlocks, in 32-byte units, each leaf starting on a
-    // 64-byte line; a leaf node's `first` is its offset in units from the start of lines_.
-    struct alignas(32) Unit {
-        float f[8];
-    };
-    struct alignas(64) Line {
-        Unit u[2];
-    };
-    std::vector<Line> lines_;  // 64-byte aligned
-    const Unit* units() const { return reinterpret_cast<const Unit*>(lines_.data()); }
-    std::vector<TriBlock> blocks_;  // during the build only: the leaves' triangles, leaf by leaf
-    const Link& link(uint32_t at) const { return *reinterpret_cast<const Link*>(units() + at); }
-    const TriBlock* blocks(uint32_t at) const {
-        return reinterpret_cast<const TriBlock*>(units() + at + sizeof(Link) / sizeof(Unit));
-    }
+    std::vector<TriBlock> blocks_;  // the leaves' triangles, leaf by leaf
     AABB bounds_;
     KdTreeStats stats_;
-    uint64_t id_ = 0;  // unique per build: names the tree in the per-thread origin cache
 };
 
 class KdTreeAccel final : public Accel {

@@ -13,17 +13,12 @@ struct RayShear {
     int kx, ky, kz;
     float sx, sy, sz;
     explicit RayShear(vec3 d) {
-        // max_dimension(abs(d)) and the cyclic order after it, in arithmetic: the axis is as
-        // likely any of the three for incoherent rays, and branches on it mispredict.
-        const float v[3] = {d.x, d.y, d.z};
-        const float ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
-        const int c1 = ax > ay, c2 = ax > az, c3 = ay > az;
-        kz = 2 - 2 * (c1 & c2) - ((c1 ^ 1) & c3);
-        kx = kz + 1 - 3 * (kz == 2);
-        ky = kx + 1 - 3 * (kx == 2);
-        sx = -v[kx] / v[kz];
-        sy = -v[ky] / v[kz];
-        sz = 1.f / v[kz];
+        kz = max_dimension(glm::abs(d));
+        kx = kz + 1 == 3 ? 0 : kz + 1;
+        ky = kx + 1 == 3 ? 0 : kx + 1;
+        sx = -d[kx] / d[kz];
+        sy = -d[ky] / d[kz];
+        sz = 1.f / d[kz];
     }
 };
 
