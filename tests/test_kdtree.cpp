@@ -95,6 +95,16 @@ bool load_obj(const std::string& path, Mesh& m) {
 // A mix of the rays that break traversals: from outside towards the geometry, from points on
 // triangles in any direction (bounce rays), along the axes from origins on split-candidate planes,
 // lying in such planes (a zero direction component), and with a [tmin, tmax] window.
+// A uniformly random point on a uniformly chosen triangle of m.
+vec3 random_surface_point(const Mesh& m, PCG32& rng) {
+    const uint32_t t = rng.next_u32() % uint32_t(m.triangles.size());
+    vec3 p0, p1, p2;
+    m.vertices(t, p0, p1, p2);
+    float u = rng.next_float(), v = rng.next_float();
+    if (u + v > 1.f) u = 1.f - u, v = 1.f - v;
+    return p0 + u * (p1 - p0) + v * (p2 - p0);
+}
+
 std::vector<Ray> make_rays(const Mesh& m, size_t n, uint64_t seed) {
     PCG32 rng(seed, 3);
     AABB b = m.bounds();
@@ -102,14 +112,7 @@ std::vector<Ray> make_rays(const Mesh& m, size_t n, uint64_t seed) {
     std::vector<Ray> rays;
     rays.reserve(n);
     auto vertex_coord = [&](int a) { return m.positions[rng.next_u32() % m.positions.size()][a]; };
-    auto surface_point = [&]() {
-        uint32_t t = rng.next_u32() % uint32_t(m.triangles.size());
-        vec3 p0, p1, p2;
-        m.vertices(t, p0, p1, p2);
-        float u = rng.next_float(), v = rng.next_float();
-        if (u + v > 1.f) u = 1.f - u, v = 1.f - v;
-        return p0 + u * (p1 - p0) + v * (p2 - p0);
-    };
+    auto surface_point = [&]() { return random_surface_point(m, rng); };
     for (size_t i = 0; i < n; ++i) {
         Ray r;
         switch (i % 6) {
@@ -221,12 +224,7 @@ std::vector<Ray> make_coherent_rays(const Mesh& m, size_t n, uint64_t seed) {
     std::vector<Ray> rays;
     rays.reserve(n);
     while (rays.size() < n) {
-        const uint32_t t = rng.next_u32() % uint32_t(m.triangles.size());
-        vec3 p0, p1, p2;
-        m.vertices(t, p0, p1, p2);
-        float u = rng.next_float(), v = rng.next_float();
-        if (u + v > 1.f) u = 1.f - u, v = 1.f - v;
-        const vec3 p = p0 + u * (p1 - p0) + v * (p2 - p0);
+        const vec3 p = random_surface_point(m, rng);
         for (int j = 0; j < 8 && rays.size() < n; ++j) {
             Ray r;
             r.o = j < 4 ? p : p + jitter * (2.f * rand_vec(rng) - 1.f);
