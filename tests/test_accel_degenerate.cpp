@@ -1,7 +1,7 @@
 // Degenerate input for every accelerator: zero-area and duplicated triangles, all triangles in one
 // plane, an axis-aligned flat mesh, a single triangle, an empty mesh. Each must build, never crash,
 // and answer exactly as brute force does. NaN or Inf vertices are rejected when the scene is
-// finalized, with a clear error.
+// built, with a clear error.
 #include <gtest/gtest.h>
 #include <string>
 #include <vector>
@@ -205,11 +205,11 @@ TEST(AccelDegenerate, AxisAlignedFlatMesh) {
 
 TEST(AccelDegenerate, NonFiniteVerticesAreRejected) {
     for (float bad : {std::numeric_limits<float>::quiet_NaN(), kInfinity}) {
-        Scene scene;
+        SceneDescription scene;
         scene.source = "test";
         scene.add_shape("bad", {vec3(0.f), vec3(1.f, 0.f, 0.f), vec3(0.f, bad, 0.f)}, {}, {uvec3(0, 1, 2)}, 0, -1);
         try {
-            scene.finalize("kdtree");
+            build_scene(std::move(scene), "kdtree");
             ADD_FAILURE() << "a vertex with " << bad << " was accepted";
         } catch (const Error& e) {
             EXPECT_NE(std::string(e.what()).find("NaN or infinite"), std::string::npos) << e.what();

@@ -18,7 +18,7 @@ using namespace candela::stats;
 namespace {
 
 // An icosphere, subdivided `subdiv` times, wound outwards (inwards when `inward`).
-void add_sphere(Scene& s, const char* name, vec3 c, float r, int subdiv, bool inward, uint32_t mat, int32_t emitter) {
+void add_sphere(SceneDescription& s, const char* name, vec3 c, float r, int subdiv, bool inward, uint32_t mat, int32_t emitter) {
     const float t = (1.f + std::sqrt(5.f)) / 2.f;
     std::vector<vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
@@ -57,7 +57,7 @@ void add_sphere(Scene& s, const char* name, vec3 c, float r, int subdiv, bool in
 }  // namespace
 
 TEST(BsdfScenes, LosslessFurnace) {
-    Scene s;
+    SceneDescription s;
     s.source = "<furnace>";
     DielectricBsdf glass;
     glass.int_ior = 1.5f;
@@ -77,14 +77,13 @@ TEST(BsdfScenes, LosslessFurnace) {
     s.settings.width = 32;
     s.settings.height = 24;
     s.settings.rr_depth = 3;
-    s.finalize();
 
     const int spp = 64;
     const double level = sidak_level(0.01, 3);
     for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Light, SamplingMode::Bsdf}) {
         s.settings.sampling = mode;
         Film film(s.settings.width, s.settings.height);
-        Renderer::render_pass(s, film, 0, spp, 0);
+        Renderer::render_pass(*build_scene(s), film, 0, spp, 0);
         // Per pixel the samples are all exactly 1 unless Russian roulette reweighted them, so the
         // test is on the mean over the image with its standard error from the pixel spread.
         RunningStats px;

@@ -34,7 +34,7 @@ TEST(Determinism, PassSplitDoesNotMatter) {
     SceneOverrides ov;
     ov.width = 24;
     ov.height = 24;
-    std::shared_ptr<Scene> scene = prepare_scene("", ov);
+    std::shared_ptr<const Scene> scene = prepare_scene("", ov);
     const Scene& s = *scene;
     Film f1(24, 24), f2(24, 24);
     for (int p = 0; p < 4; ++p) Renderer::render_pass(s, f1, uint32_t(p * 2), 2, 2);
@@ -54,10 +54,12 @@ TEST(Determinism, DiffuseOnlySpecialisationDropsCodeNotSamples) {
     SceneOverrides ov;
     ov.width = 20;
     ov.height = 20;
-    std::shared_ptr<Scene> scene = prepare_scene("", ov);  // the built-in Cornell box: all diffuse
-    ASSERT_TRUE(scene_is_diffuse_only(*scene));
+    std::shared_ptr<const Scene> box = prepare_scene("", ov);  // the built-in Cornell box: all diffuse
+    ASSERT_TRUE(scene_is_diffuse_only(*box));
     for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Light, SamplingMode::Bsdf}) {
-        scene->settings.sampling = mode;
+        SceneParams p = box->params();
+        p.settings.sampling = mode;
+        std::shared_ptr<const Scene> scene = box->with_params(p);
         PathIntegrator integrator(*scene);
         PathStats ps_general, ps_special;
         int nonzero = 0;
@@ -80,13 +82,13 @@ TEST(Determinism, DiffuseOnlySpecialisationDropsCodeNotSamples) {
         EXPECT_GT(nonzero, mode == SamplingMode::Bsdf ? 10 : 20 * 20 * 4 / 2) << "mode " << int(mode);
     }
     // A scene with a mirror and glass is not diffuse-only: it takes the general instantiation.
-    Scene glass = load_scene(std::string(CANDELA_SOURCE_DIR) + "/scenes/cornell-materials/mirror-glass.xml");
-    EXPECT_FALSE(scene_is_diffuse_only(glass));
+    auto glass = build_scene(load_scene(std::string(CANDELA_SOURCE_DIR) + "/scenes/cornell-materials/mirror-glass.xml"));
+    EXPECT_FALSE(scene_is_diffuse_only(*glass));
 }
 
 TEST(SceneMemory, CountsWhatTheSceneHolds) {
     SceneOverrides ov;
-    std::shared_ptr<Scene> scene = prepare_scene("", ov);
+    std::shared_ptr<const Scene> scene = prepare_scene("", ov);
     const Scene::Memory m = scene->memory();
     const Mesh& mesh = scene->mesh;
     EXPECT_EQ(m.triangles, 32u);

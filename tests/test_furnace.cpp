@@ -86,8 +86,8 @@ struct FurnaceConfig {
     uint64_t seed = 0;
 };
 
-std::unique_ptr<Scene> furnace_scene(const FurnaceConfig& c) {
-    auto sc = std::make_unique<Scene>();
+std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c) {
+    auto sc = std::make_unique<SceneDescription>();
     sc->source = "<furnace>";
     std::vector<dvec3> v;
     std::vector<uvec3> f;
@@ -106,9 +106,10 @@ std::unique_ptr<Scene> furnace_scene(const FurnaceConfig& c) {
     sc->camera.fov_deg = 90.f;
     sc->camera.near_clip = float(1e-3 * c.radius);
     sc->camera.far_clip = float(10.0 * c.radius);
-    sc->finalize("brute");
     return sc;
 }
+
+std::shared_ptr<const Scene> furnace_scene(const FurnaceConfig& c) { return build_scene(*furnace_description(c), "brute"); }
 
 struct FurnaceResult {
     RunningStats pixels[3];  // per channel, over pixel means
@@ -201,11 +202,11 @@ TEST(Furnace, DetectsBias) {
     EXPECT_LT(z_test(r.pixels[1], 1.02 * expected, 1e-5 * expected).p_value, level);
 
     // A hole: drop one triangle far from where the camera looks (still the same z-test).
-    auto sc = furnace_scene(c);
-    sc->mesh.triangles.pop_back();
-    sc->mesh.tri_shape.pop_back();
-    sc->shapes[0].triangle_count -= 1;
-    sc->finalize("brute");
+    auto d = furnace_description(c);
+    d->mesh.triangles.pop_back();
+    d->mesh.tri_shape.pop_back();
+    d->shapes[0].triangle_count -= 1;
+    auto sc = build_scene(std::move(*d), "brute");
     Film film(16, 16);
     Renderer::render_pass(*sc, film, 0, c.spp, 2);
     RunningStats s;

@@ -42,18 +42,19 @@ ImageEstimate load_reference() {
 }
 
 ImageEstimate render_candela(float white_scale) {
-    Scene scene = make_cornell_box();
+    SceneDescription scene = make_cornell_box();
     std::get<DiffuseBsdf>(scene.materials[0].bsdf).albedo *= white_scale;
     scene.settings.width = kRes;
     scene.settings.height = kRes;
-    scene.finalize();
+    const std::shared_ptr<const Scene> built = build_scene(scene);
     const int batches = 8, spp = 64;
     std::vector<std::unique_ptr<Film>> films;
     std::vector<const Film*> ptrs;
     for (int b = 0; b < batches; ++b) {
         films.push_back(std::make_unique<Film>(kRes, kRes));
-        scene.settings.seed = uint64_t(b + 1);
-        Renderer::render_pass(scene, *films.back(), 0, spp, 0);
+        SceneParams p = built->params();
+        p.settings.seed = uint64_t(b + 1);
+        Renderer::render_pass(*built->with_params(p), *films.back(), 0, spp, 0);
         ptrs.push_back(films.back().get());
     }
     return ImageEstimate::from_batches(ptrs);

@@ -19,18 +19,16 @@ struct LightSpec {
     vec3 radiance;
 };
 
-// A scene holding only emitters (and one diffuse material). Heap-allocated: the light set keeps a
-// pointer to the scene's mesh, so the scene must not move after finalize().
-std::unique_ptr<Scene> make_scene(const std::vector<LightSpec>& lights) {
-    auto sc = std::make_unique<Scene>();
+// A scene holding only emitters (and one diffuse material).
+std::shared_ptr<const Scene> make_scene(const std::vector<LightSpec>& lights) {
+    auto sc = std::make_unique<SceneDescription>();
     sc->source = "<test_light>";
     sc->materials.push_back(Material{"white", DiffuseBsdf{vec3(0.5f)}, false});
     for (size_t i = 0; i < lights.size(); ++i) {
         sc->emitters.push_back(AreaEmitter{lights[i].radiance});
         sc->add_shape("light" + std::to_string(i), lights[i].positions, {}, lights[i].triangles, 0, int32_t(i));
     }
-    sc->finalize("brute");
-    return sc;
+    return build_scene(std::move(*sc), "brute");
 }
 
 // Solid angle of triangle (a, b, c) seen from p (Van Oosterom and Strackee 1983):

@@ -19,21 +19,23 @@ namespace {
 
 constexpr double kAlpha = 0.01;
 
-std::unique_ptr<Scene> load(const std::string& rel, int w, int h, int max_depth) {
-    auto s = std::make_unique<Scene>(load_scene(std::string(CANDELA_SOURCE_DIR) + "/" + rel));
-    s->settings.width = w;
-    s->settings.height = h;
-    s->settings.max_depth = max_depth;
-    s->finalize();
-    return s;
+std::shared_ptr<const Scene> load(const std::string& rel, int w, int h, int max_depth) {
+    SceneDescription d = load_scene(std::string(CANDELA_SOURCE_DIR) + "/" + rel);
+    d.settings.width = w;
+    d.settings.height = h;
+    d.settings.max_depth = max_depth;
+    return build_scene(std::move(d));
 }
 
 // K independent batches of spp samples each, for the batch-means variance of every pixel. Each
 // mode gets a seed of its own: with one seed, light and MIS sampling draw the same random numbers,
 // trace nearly the same paths, and a z-test that treats them as independent could hardly fail.
-ImageEstimate render(Scene& s, SamplingMode mode, int batches, int spp) {
-    s.settings.sampling = mode;
-    s.settings.seed = 0x9e3779b9u * (uint32_t(mode) + 1u);
+ImageEstimate render(const Scene& base, SamplingMode mode, int batches, int spp) {
+    SceneParams p = base.params();
+    p.settings.sampling = mode;
+    p.settings.seed = 0x9e3779b9u * (uint32_t(mode) + 1u);
+    const std::shared_ptr<const Scene> scene = base.with_params(p);
+    const Scene& s = *scene;
     std::vector<std::unique_ptr<Film>> films;
     std::vector<const Film*> ptrs;
     for (int b = 0; b < batches; ++b) {
@@ -63,7 +65,7 @@ struct Result {
     ImageEstimate light, bsdf, mis;
 };
 
-Result render_all(Scene& s, int batches, int spp) {
+Result render_all(const Scene& s, int batches, int spp) {
     Result r;
     r.light = render(s, SamplingMode::Light, batches, spp);
     r.bsdf = render(s, SamplingMode::Bsdf, batches, spp);
@@ -103,10 +105,11 @@ TEST(Mis, VeachSceneStrategiesAgreeAndMisWins) {
     // alpha 0.05: at alpha 0.01, light sampling still misses its rare spikes at 1024 spp (measured:
     // -2.7 % at 8192 spp, +1.3 % at 65536 spp against MIS on the brightest block: noise, not bias).
     {
-        auto a = load("scenes/veach-mis/scene.xml", 48, 32, 1);
-        for (Material& m : a->materials)
+        auto loaded = load("scenes/veach-mis/scene.xml", 48, 32, 1);
+        SceneParams p = loaded->params();
+        for (Material& m : p.materials)
             if (auto* c = std::get_if<ConductorBsdf>(&m.bsdf)) c->alpha = std::max(c->alpha, 0.05f);
-        Result r = render_all(*a, 16, 512);
+        Result r = render_all(*loaded->with_params(p), 16, 512);
         check_agreement(r, "veach", 16);
         // Control: the same comparison rejects a light-sampled image 3% too bright.
         const double level = sidak_level(kAlpha, 3);

@@ -37,7 +37,7 @@ void expect_error(const std::string& text, int line, const std::string& what) {
     EXPECT_NE(msg.find(what), std::string::npos) << "message: " << msg;
 }
 
-vec3 albedo(const Scene& s, const Shape& sh) { return std::get<DiffuseBsdf>(s.materials[sh.material].bsdf).albedo; }
+vec3 albedo(const SceneDescription& s, const Shape& sh) { return std::get<DiffuseBsdf>(s.materials[sh.material].bsdf).albedo; }
 
 void expect_near(vec3 a, vec3 b, float eps = 1e-5f) {
     EXPECT_NEAR(a.x, b.x, eps);
@@ -48,7 +48,7 @@ void expect_near(vec3 a, vec3 b, float eps = 1e-5f) {
 }  // namespace
 
 TEST(ObjLoader, MaterialsEmittersAndGroups) {
-    Scene s = load_obj_scene(std::string(CANDELA_TEST_DATA) + "/scenes/lights.obj");
+    SceneDescription s = load_obj_scene(std::string(CANDELA_TEST_DATA) + "/scenes/lights.obj");
     ASSERT_EQ(s.shapes.size(), 3u);  // floor (no material), wall/red, wall/lamp
     EXPECT_EQ(s.shapes[0].name, "floor");
     EXPECT_EQ(s.shapes[0].triangle_count, 2u);
@@ -73,13 +73,12 @@ TEST(ObjLoader, MaterialsEmittersAndGroups) {
     EXPECT_EQ(s.settings.height, 512);
     EXPECT_EQ(s.settings.spp, 64);
     EXPECT_EQ(s.settings.max_depth, -1);
-    s.finalize();
-    EXPECT_EQ(s.lights.triangle_count(), 1u);
+    EXPECT_EQ(build_scene(s)->lights.triangle_count(), 1u);
 }
 
 TEST(ObjLoader, DefaultCameraFramesBounds) {
     std::string path = write_temp("box.obj", "v -1 -1 -1\nv 3 -1 -1\nv 3 1 1\nf 1 2 3\n");
-    Scene s = load_obj_scene(path);
+    SceneDescription s = load_obj_scene(path);
     vec3 origin = vec3(s.camera.to_world[3]);
     vec3 centre(1.f, 0.f, 0.f);
     float r = 0.5f * glm::length(vec3(4.f, 2.f, 2.f));
@@ -98,7 +97,7 @@ TEST(ObjLoader, VertexNormalsWhereGiven) {
                                   "g smooth\nf 1//1 2//1 3//2\n"
                                   "g flat\nf 1 2 4\n"
                                   "g mixed\nf 1//1 3 4\n");
-    Scene s = load_obj_scene(path);
+    SceneDescription s = load_obj_scene(path);
     ASSERT_EQ(s.shapes.size(), 3u);
     EXPECT_TRUE(s.shapes[0].smooth);
     EXPECT_FALSE(s.shapes[1].smooth);
@@ -110,7 +109,7 @@ TEST(ObjLoader, VertexNormalsWhereGiven) {
 
 TEST(ObjLoader, RelativeIndicesAndPolygons) {
     std::string path = write_temp("rel.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf -5 -4 -3 -2 -1\n");
-    Scene s = load_obj_scene(path);
+    SceneDescription s = load_obj_scene(path);
     ASSERT_EQ(s.mesh.triangles.size(), 3u);  // a pentagon becomes a fan of three
     vec3 a, b, c;
     s.mesh.vertices(2, a, b, c);
@@ -121,20 +120,20 @@ TEST(ObjLoader, RelativeIndicesAndPolygons) {
 
 TEST(ObjLoader, DegenerateTrianglesAreKept) {
     std::string path = write_temp("deg.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\nf 1 1 1\n");
-    Scene s = load_obj_scene(path);
+    SceneDescription s = load_obj_scene(path);
     EXPECT_EQ(s.mesh.triangles.size(), 3u);
-    s.finalize();
+    auto built = build_scene(s);
     Ray r;
     r.o = vec3(0.25f, 0.25f, 1.f);
     r.d = vec3(0, 0, -1);
     Hit h;
-    EXPECT_TRUE(s.accel->intersect(r, h));
+    EXPECT_TRUE(built->accel->intersect(r, h));
     EXPECT_EQ(h.prim, 1u);
 }
 
 TEST(ObjLoader, MissingMtlIsAWarning) {
     std::string path = write_temp("nomtl.obj", "mtllib does_not_exist.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
-    Scene s = load_obj_scene(path);
+    SceneDescription s = load_obj_scene(path);
     ASSERT_EQ(s.shapes.size(), 1u);
     expect_near(albedo(s, s.shapes[0]), vec3(0.5f));
     EXPECT_FALSE(s.warnings.empty());

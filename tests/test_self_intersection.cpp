@@ -39,15 +39,14 @@ bool hits_triangle(const Mesh& mesh, uint32_t tri, const Ray& ray) {
 }
 
 // A scene holding the given triangles as one shape (no emitters, brute-force accelerator).
-std::unique_ptr<Scene> make_scene(const std::vector<vec3>& pos, const std::vector<uvec3>& tris,
-                                  const std::string& accel = "brute") {
-    auto sc = std::make_unique<Scene>();
+std::shared_ptr<const Scene> make_scene(const std::vector<vec3>& pos, const std::vector<uvec3>& tris,
+                                        const std::string& accel = "brute") {
+    auto sc = std::make_unique<SceneDescription>();
     sc->source = "<self-intersection>";
     sc->materials.push_back(Material{"white", DiffuseBsdf{vec3(0.5f)}, false});
     sc->add_shape("mesh", pos, {}, tris, 0, -1);
     sc->settings.width = sc->settings.height = 1;
-    sc->finalize(accel);
-    return sc;
+    return build_scene(std::move(*sc), accel);
 }
 
 struct Counts {
@@ -131,7 +130,7 @@ Counts probe(const Scene& sc, uint64_t seed, int n_points, int dirs_per_point, b
 }
 
 // Random triangles of one family, each its own shape in one scene.
-std::unique_ptr<Scene> triangle_family(const char* kind, uint64_t seed, int n) {
+std::shared_ptr<const Scene> triangle_family(const char* kind, uint64_t seed, int n) {
     PCG32 rng(seed, 1);
     std::vector<vec3> pos;
     std::vector<uvec3> tris;

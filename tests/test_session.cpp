@@ -17,11 +17,11 @@ using namespace candela;
 
 namespace {
 
-std::shared_ptr<Scene> cornell(int w, int h) {
+std::shared_ptr<const Scene> cornell(int w, int h) {
     SceneOverrides ov;
     ov.width = w;
     ov.height = h;
-    return prepare_scene_shared("", ov);
+    return prepare_scene("", ov);
 }
 
 double image_sum(const SessionImage& img) {
@@ -97,7 +97,7 @@ TEST(Session, FirstImageIsAQuarterResolutionPreview) {
 
 TEST(Session, LightEditRestartsAndRebuildsTheLights) {
     auto scene = cornell(32, 32);
-    SceneParams params = SceneParams::from(*scene);
+    SceneParams params = scene->params();
     SessionOptions opt;
     opt.threads = 2;
     opt.max_passes = 2;
@@ -118,7 +118,7 @@ TEST(Session, LightEditRestartsAndRebuildsTheLights) {
 
 TEST(Session, MaterialEditChangesTheImage) {
     auto scene = cornell(32, 32);
-    SceneParams params = SceneParams::from(*scene);
+    SceneParams params = scene->params();
     SessionOptions opt;
     opt.threads = 2;
     opt.max_passes = 4;
@@ -137,7 +137,7 @@ TEST(Session, MaterialEditChangesTheImage) {
 TEST(Session, EditsReturnAtOnceAndRestartWithinATile) {
     // Slow passes (64 spp at 256 x 256): a restart must not wait for the pass to finish.
     auto scene = cornell(256, 256);
-    SceneParams params = SceneParams::from(*scene);
+    SceneParams params = scene->params();
     SessionOptions opt;
     opt.threads = 2;
     opt.spp_per_pass = 64;
@@ -165,7 +165,7 @@ TEST(Session, EditsReturnAtOnceAndRestartWithinATile) {
 
 TEST(Session, InteractiveRendersPreviewsOnlyUntilReleased) {
     auto scene = cornell(64, 64);
-    SceneParams params = SceneParams::from(*scene);
+    SceneParams params = scene->params();
     SessionOptions opt;
     opt.threads = 2;
     opt.max_passes = 3;
@@ -289,4 +289,64 @@ TEST(Session, ThreadCountChangeDoesNotRestart) {
     std::vector<float> ref = film.resolve();
     ASSERT_EQ(img.rgb.size(), ref.size());
     for (size_t i = 0; i < ref.size(); ++i) ASSERT_EQ(img.rgb[i], ref[i]) << "at float " << i;
+}
+
+// The front end reads snapshots while the worker applies edits. A snapshot never changes (the
+// worker builds a new scene for every edit), so the window can read any part of it (emitters,
+// materials, settings: what the panel shows) without a lock; under ThreadSanitizer this is the
+// check that the window and the worker share no mutable scene state.
+TEST(Session, FrontEndReadsSnapshotsWhileTheWorkerEdits) {
+    auto scene = cornell(24, 24);
+    SceneParams params = scene->params();
+    SessionOptions opt;
+    opt.threads = 2;
+    RenderSession session(scene, opt);
+    const std::shared_ptr<const Scene> first = session.scene();
+    const vec3 L0 = first->emitters[0].radiance;
+    uint64_t gen = 0;
+    double seen = 0;
+    for (int i = 1; i <= 40; ++i) {
+        params.emitters[0].radiance = L0 * (1.f + 0.01f * float(i));
+        std::get<DiffuseBsdf>(params.materials[0].bsdf).albedo = vec3(0.5f + 0.01f * float(i));
+        params.settings.max_depth = i % 5;
+        gen = session.update(params);
+        // What the panel reads, from whatever snapshot is current.
+        std::shared_ptr<const Scene> s = session.scene();
+        seen += s->emitters[0].radiance.x + std::get<DiffuseBsdf>(s->materials[0].bsdf).albedo.x +
+                double(s->settings.max_depth) + double(s->lights.triangle_count());
+        if (i % 8 == 0) {
+            ASSERT_TRUE(session.wait_for(gen, 0, 60));
+        }
+    }
+    ASSERT_TRUE(session.wait_for(gen, 1, 60));
+    EXPECT_GT(seen, 0.0);
+    // The first snapshot is untouched; the current one has the last edit, with its own light set
+    // over the same geometry and accelerator.
+    EXPECT_EQ(first->emitters[0].radiance, L0);
+    std::shared_ptr<const Scene> last = session.scene();
+    EXPECT_EQ(last->emitters[0].radiance, params.emitters[0].radiance);
+    EXPECT_EQ(last->settings.max_depth, params.settings.max_depth);
+    EXPECT_EQ(last->geometry.get(), first->geometry.get());
+    EXPECT_EQ(last->accel.get(), first->accel.get());
+    EXPECT_NE(last->light_set.get(), first->light_set.get());
+}
+
+// An edit that does not fit the scene (here: a material missing) is refused by the worker, which
+// keeps rendering the last good parameters and says why; nothing throws on either thread.
+TEST(Session, AnEditThatDoesNotFitIsRefused) {
+    auto scene = cornell(16, 16);
+    SceneParams params = scene->params();
+    SessionOptions opt;
+    opt.threads = 1;
+    opt.max_passes = 2;
+    RenderSession session(scene, opt);
+    ASSERT_TRUE(session.wait_for(0, 2, 60));
+    const double before = image_sum(session.latest_full_image());
+    params.materials.pop_back();
+    uint64_t gen = session.update(params);
+    ASSERT_TRUE(session.wait_for(gen, 2, 60));
+    SessionStats st = session.stats();
+    EXPECT_NE(st.error.find("names material"), std::string::npos) << st.error;
+    EXPECT_EQ(session.scene()->materials.size(), scene->materials.size());
+    EXPECT_EQ(image_sum(session.latest_full_image()), before);  // the same samples of the same scene
 }

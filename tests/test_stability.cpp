@@ -31,8 +31,8 @@ constexpr double kAlpha = 0.01;
 // The built-in Cornell box, every vertex and the camera mapped by p -> scale * p + offset (near and
 // far clip scaled too). The radiance image is invariant under this map. With `slivers`, each quad
 // is tessellated into fans whose thinnest triangles have angles ~1e-6 rad: same surfaces, same image.
-std::unique_ptr<Scene> cornell(float scale = 1.f, vec3 offset = vec3(0.f), bool slivers = false) {
-    auto s = std::make_unique<Scene>();
+std::unique_ptr<SceneDescription> cornell(float scale = 1.f, vec3 offset = vec3(0.f), bool slivers = false) {
+    auto s = std::make_unique<SceneDescription>();
     s->source = "<stability Cornell box>";
     s->materials = {{"white", DiffuseBsdf{kCornellWhite}, false},
                     {"red", DiffuseBsdf{kCornellRed}, false},
@@ -69,10 +69,7 @@ std::unique_ptr<Scene> cornell(float scale = 1.f, vec3 offset = vec3(0.f), bool 
     return s;
 }
 
-void finalize(Scene& s, int res, const std::string& accel = "auto") {
-    s.settings.width = s.settings.height = res;
-    s.finalize(accel);
-}
+void set_resolution(SceneDescription& s, int res) { s.settings.width = s.settings.height = res; }
 
 struct Renders {
     std::vector<std::unique_ptr<Film>> films;
@@ -85,12 +82,14 @@ struct Renders {
 };
 
 // `batches` independent films of `spp` samples each (seeds seed0, seed0 + 1, ...).
-Renders render(Scene& s, int batches, int spp, uint64_t seed0) {
+Renders render(const SceneDescription& desc, int batches, int spp, uint64_t seed0) {
     Renders r;
+    const std::shared_ptr<const Scene> scene = build_scene(desc);
     for (int b = 0; b < batches; ++b) {
-        r.films.push_back(std::make_unique<Film>(s.settings.width, s.settings.height));
-        s.settings.seed = seed0 + uint64_t(b);
-        Renderer::render_pass(s, *r.films.back(), 0, spp, 0);
+        r.films.push_back(std::make_unique<Film>(desc.settings.width, desc.settings.height));
+        SceneParams p = scene->params();
+        p.settings.seed = seed0 + uint64_t(b);
+        Renderer::render_pass(*scene->with_params(p), *r.films.back(), 0, spp, 0);
         r.nonfinite += r.films.back()->nonfinite_count();
     }
     return r;
@@ -122,7 +121,7 @@ constexpr int kRes = 32, kBatches = 8, kSpp = 32;
 const ImageEstimate& reference_box() {
     static ImageEstimate ref = [] {
         auto s = cornell();
-        finalize(*s, kRes);
+        set_resolution(*s, kRes);
         Renders r = render(*s, kBatches, kSpp, 1);
         EXPECT_EQ(r.nonfinite, 0u);
         return r.estimate();
@@ -150,7 +149,7 @@ TEST(Stability, ScaledAndMovedCornellBoxRendersTheSameImage) {
     uint64_t seed = 1000;
     for (const Case& c : cases) {
         auto s = cornell(c.scale, c.offset, std::string(c.name) == "slivers");
-        finalize(*s, kRes);
+        set_resolution(*s, kRes);
         Renders r = render(*s, kBatches, kSpp, seed);
         seed += 100;
         EXPECT_EQ(r.nonfinite, 0u) << c.name;
@@ -168,7 +167,7 @@ TEST(Stability, ScaleComparisonDetectsThreePercentError) {
     const ImageEstimate& ref = reference_box();
     auto s = cornell(1e5f);
     std::get<DiffuseBsdf>(s->materials[0].bsdf).albedo *= 0.97f;
-    finalize(*s, kRes);
+    set_resolution(*s, kRes);
     ImageEstimate e = render(*s, kBatches, kSpp, 5000).estimate();
     const double level = sidak_level(kAlpha, 8);
     BlockTestResult b = block_z_test(e, ref, 4, level);
@@ -316,7 +315,7 @@ TEST(Stability, ExtremeMaterialsInTheBoxStayFinite) {
                 s->camera.to_world = look_at(vec3(278.f, 1e-4f, 1.f), vec3(278.f, 1e-4f, 2.f), vec3(0.f, 1.f, 0.f));
                 s->camera.near_clip = 1e-3f;
             }
-            finalize(*s, 12);
+            set_resolution(*s, 12);
             Renders r = render(*s, 1, 8, 77);
             total += r.nonfinite;
             EXPECT_EQ(r.nonfinite, 0u) << nb.name << (grazing ? " (grazing camera)" : "");
@@ -329,12 +328,12 @@ TEST(Stability, ExtremeMaterialsInTheBoxStayFinite) {
 // (the same random numbers make the same paths; only L is multiplied).
 TEST(Stability, TinyAndBrightLights) {
     auto base = cornell();
-    finalize(*base, 16);
+    set_resolution(*base, 16);
     Renders r0 = render(*base, 1, 16, 3);
 
     auto bright = cornell();
     bright->emitters[0].radiance *= 1e6f;
-    finalize(*bright, 16);
+    set_resolution(*bright, 16);
     Renders r1 = render(*bright, 1, 16, 3);
     EXPECT_EQ(r0.nonfinite + r1.nonfinite, 0u);
     double max_rel = 0;
@@ -366,10 +365,11 @@ TEST(Stability, TinyAndBrightLights) {
                 }
             }
     tiny->emitters[0].radiance *= 1e8f;
-    finalize(*tiny, 16);
+    set_resolution(*tiny, 16);
     float light_area = 0.f;
+    const auto tiny_built = build_scene(*tiny);
     for (uint32_t t = 0; t < tiny->mesh.triangle_count(); ++t)
-        if (tiny->lights.emitter_of(t) >= 0) light_area += tiny->mesh.triangle_area(t);
+        if (tiny_built->lights.emitter_of(t) >= 0) light_area += tiny->mesh.triangle_area(t);
     std::printf("  tiny light: %.3g of the scene's area\n", double(light_area / area_total));
     EXPECT_LT(light_area / area_total, 2e-8f);
     for (SamplingMode m : {SamplingMode::Light, SamplingMode::Bsdf, SamplingMode::Mis}) {
@@ -388,7 +388,7 @@ TEST(Stability, MaxDepthZeroOneAndTenThousand) {
     for (int d : {0, 1}) {
         auto s = cornell();
         s->settings.max_depth = d;
-        finalize(*s, 16);
+        set_resolution(*s, 16);
         Renders r = render(*s, 1, 16, 21);
         EXPECT_EQ(r.nonfinite, 0u) << d;
         for (int y = 0; y < 16 && d == 0; ++y)
@@ -397,7 +397,7 @@ TEST(Stability, MaxDepthZeroOneAndTenThousand) {
     auto deep = cornell();
     deep->settings.max_depth = 10000;
     deep->settings.rr_depth = 10000;
-    finalize(*deep, kRes);
+    set_resolution(*deep, kRes);
     Renders r = render(*deep, kBatches, kSpp, 31);
     EXPECT_EQ(r.nonfinite, 0u);
     ImageEstimate e = r.estimate();
@@ -426,14 +426,15 @@ TEST(Stability, MillionSamplesInOnePixel) {
     EXPECT_FLOAT_EQ(f.pixel(0, 0).z, 1e-3f);
 
     auto s = cornell();
-    finalize(*s, 1);
+    set_resolution(*s, 1);
     s->settings.seed = 123;
+    const auto built = build_scene(*s);
     Film film(1, 1);
     const int passes = 16, per_pass = 62500;
     RunningStats batch[3];
     dvec3 prev(0.0);
     for (int p = 0; p < passes; ++p) {
-        Renderer::render_pass(*s, film, uint32_t(p * per_pass), per_pass, 0);
+        Renderer::render_pass(*built, film, uint32_t(p * per_pass), per_pass, 0);
         dvec3 sum = film.pixel_sum(0, 0);
         for (int c = 0; c < 3; ++c) batch[c].add((sum[c] - prev[c]) / per_pass);
         prev = sum;
@@ -481,7 +482,7 @@ TEST(Stability, SliverTrianglesStayFinite) {
     s->emitters.push_back({vec3(1e3f)});
     s->add_shape("slivers", pos, {}, tris, 0, 1);
     s->add_shape("sliver-occluders", pos, {}, tris, 0, -1);
-    finalize(*s, 16);
+    set_resolution(*s, 16);
     for (SamplingMode m : {SamplingMode::Light, SamplingMode::Bsdf, SamplingMode::Mis}) {
         s->settings.sampling = m;
         Renders r = render(*s, 1, 16, 41);

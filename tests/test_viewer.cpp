@@ -40,7 +40,7 @@ void expect_near(vec3 a, vec3 b, float tol, const char* what) {
 // ---- camera controller ------------------------------------------------------------------------
 
 TEST(CameraControl, ResetRestoresTheSceneCameraExactly) {
-    auto sp = prepare_scene_shared("", {});
+    auto sp = prepare_scene("", {});
     const Scene& s = *sp;
     CameraController c(s.camera, s.mesh.bounds());
     c.orbit(0.3f, 0.2f);
@@ -56,7 +56,7 @@ TEST(CameraControl, ResetRestoresTheSceneCameraExactly) {
 }
 
 TEST(CameraControl, OrbitKeepsTheTargetInViewAtTheSameDistance) {
-    auto sp = prepare_scene_shared("", {});
+    auto sp = prepare_scene("", {});
     const Scene& s = *sp;
     CameraController c(s.camera, s.mesh.bounds());
     const vec3 target = c.target();
@@ -81,7 +81,7 @@ TEST(CameraControl, OrbitKeepsTheTargetInViewAtTheSameDistance) {
 }
 
 TEST(CameraControl, PanDollyAndFly) {
-    auto sp = prepare_scene_shared("", {});
+    auto sp = prepare_scene("", {});
     const Scene& s = *sp;
     CameraController c(s.camera, s.mesh.bounds());
     vec3 o = c.origin(), t = c.target(), fwd = c.forward();
@@ -108,7 +108,7 @@ TEST(CameraControl, PanDollyAndFly) {
 TEST(ViewerPick, NamesWhatIsUnderThePixel) {
     SceneOverrides ov;
     ov.width = ov.height = 64;
-    auto sp = prepare_scene_shared("", ov);
+    auto sp = prepare_scene("", ov);
     const Scene& s = *sp;
     auto shape_at = [&](float x, float y) {
         PickResult r = pick(s, s.camera, vec2(x, y));

@@ -71,7 +71,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 // Cornell box from behind, and its bounce rays would leave the box).
 Mesh load_mesh(const std::string& path, std::optional<Camera>* camera = nullptr) {
     if (ends_with(path, ".xml")) {
-        Scene scene = load_scene(path);
+        SceneDescription scene = load_scene(path);
         if (camera) *camera = scene.camera;
         return std::move(scene.mesh);
     }

@@ -154,9 +154,11 @@ int run_depth_bias(const std::string& scene_path, const SceneOverrides& base, in
     auto render_means = [&](int depth, std::vector<double>& lum) {
         SceneOverrides ov = base;
         ov.max_depth = depth;
-        auto sc = prepare_scene(scene_path, ov);
+        auto base_scene = prepare_scene(scene_path, ov);
         for (int b = 0; b < batches; ++b) {
-            sc->settings.seed = uint64_t(1000 + b);
+            SceneParams p = base_scene->params();
+            p.settings.seed = uint64_t(1000 + b);
+            auto sc = base_scene->with_params(p);
             Film film(sc->settings.width, sc->settings.height);
             Renderer::render_pass(*sc, film, 0, spp, threads);
             if (film.nonfinite_count()) std::fprintf(stderr, "warning: %llu non-finite samples\n",

@@ -80,7 +80,7 @@ int run_headless(const HeadlessOptions& opt) {
     g_finish_pass = !opt.checkpoint.empty();
     install_signal_handlers();
 
-    std::shared_ptr<Scene> scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    std::shared_ptr<const Scene> scene_ptr = prepare_scene(opt.scene, opt.overrides);
     const Scene& scene = *scene_ptr;
     const RenderSettings& st = scene.settings;
     if (!opt.quiet)

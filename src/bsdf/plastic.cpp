@@ -97,16 +97,36 @@ std::shared_ptr<const CoatTables> compute_tables(float alpha, float eta) {
 
 }  // namespace
 
+namespace {
+
+// Scenes often share one coat among many objects, and the viewer's scenes share it between the
+// versions an edit makes: tables are shared by (alpha, eta). The cache holds them weakly, so a
+// table lives as long as some material uses it; a roughness slider dragged through a thousand
+// values leaves only the tables still in use (expired entries are dropped on every insertion).
+std::mutex coat_cache_mutex;
+std::map<std::pair<float, float>, std::weak_ptr<const CoatTables>> coat_cache;
+
+}  // namespace
+
+size_t coat_table_cache_size() {
+    std::lock_guard<std::mutex> lock(coat_cache_mutex);
+    return coat_cache.size();
+}
+
 void PlasticBsdf::prepare() {
     if (prepared()) return;
-    // Scenes often share one coat among many objects; keep a small cache keyed by (alpha, eta).
-    static std::mutex mutex;
-    static std::map<std::pair<float, float>, std::shared_ptr<const CoatTables>> cache;
     const float a = smooth() ? 0.f : alpha;
-    std::lock_guard<std::mutex> lock(mutex);
-    auto& slot = cache[{a, eta()}];
-    if (!slot) slot = compute_tables(a, eta());
-    tables = slot;
+    std::lock_guard<std::mutex> lock(coat_cache_mutex);
+    std::weak_ptr<const CoatTables>& slot = coat_cache[{a, eta()}];
+    std::shared_ptr<const CoatTables> t = slot.lock();
+    if (!t) {
+        // Computed under the lock: two threads preparing the same coat compute it once.
+        t = compute_tables(a, eta());
+        slot = t;
+        for (auto it = coat_cache.begin(); it != coat_cache.end();)
+            it = it->second.expired() ? coat_cache.erase(it) : std::next(it);
+    }
+    tables = std::move(t);
 }
 
 // ---- evaluation --------------------------------------------------------------------------------

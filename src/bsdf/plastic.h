@@ -22,6 +22,9 @@ struct CoatTables {
     float transmittance_at(float cos_theta) const;  // linear interpolation in the table
 };
 
+// Coats whose tables are alive in the shared cache (PlasticBsdf::prepare), for tests.
+size_t coat_table_cache_size();
+
 // A dielectric coat over a Lambertian base (Mitsuba 3 `plastic` and `roughplastic`, nonlinear =
 // false by default). eta = int_ior / ext_ior. With T(mu) the coat's transmittance, Ri its internal
 // reflectance and rho = diffuse_reflectance:

@@ -6,8 +6,7 @@ namespace candela {
 
 namespace {
 
-void apply_overrides_and_finalize(Scene& scene, const SceneOverrides& ov) {
-    RenderSettings& st = scene.settings;
+void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
     if (ov.width) st.width = *ov.width;
     if (ov.height) st.height = *ov.height;
     if (ov.max_depth) st.max_depth = *ov.max_depth;
@@ -16,15 +15,14 @@ void apply_overrides_and_finalize(Scene& scene, const SceneOverrides& ov) {
     if (ov.sampling) st.sampling = *ov.sampling;
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
-    scene.finalize(ov.accel);
 }
 
 }  // namespace
 
-std::shared_ptr<Scene> prepare_scene(const std::string& path, const SceneOverrides& ov) {
-    auto scene = std::make_shared<Scene>(path.empty() ? make_cornell_box() : load_scene(path, ov.defines));
-    apply_overrides_and_finalize(*scene, ov);
-    return scene;
+std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov) {
+    SceneDescription desc = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
+    apply_overrides(desc.settings, ov);
+    return build_scene(std::move(desc), ov.accel);
 }
 
 SamplingMode parse_sampling_mode(const std::string& s) {

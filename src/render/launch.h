@@ -17,14 +17,9 @@ struct SceneOverrides {
     std::string accel = "auto";
 };
 
-// Loads `path` (or the built-in Cornell box when empty), applies the overrides and finalises the
-// scene (accelerator, lights, camera). Throws Error with file:line on bad input. The scene lives on
-// the heap because a finalized Scene must never move: its accelerator and lights point into its
-// mesh. It is shared, since the viewer hands it to render threads.
-std::shared_ptr<Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
-inline std::shared_ptr<Scene> prepare_scene_shared(const std::string& path, const SceneOverrides& ov) {
-    return prepare_scene(path, ov);  // the viewer's older name; same function
-}
+// Loads `path` (or the built-in Cornell box when empty), applies the overrides and builds the
+// scene (accelerator, lights, prepared materials). Throws Error with file:line on bad input.
+std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
 const char* sampling_mode_name(SamplingMode m);

@@ -15,6 +15,9 @@ PassStats run_pass(const Scene& scene, Film& film, uint32_t first_sample, int sp
     const int tiles_y = (h + Renderer::kTileSize - 1) / Renderer::kTileSize;
     const int n_tiles = tiles_x * tiles_y;
     PathIntegrator integrator(scene);
+    // The scene's camera for this film: a preview renders the same view at a smaller size.
+    Camera camera = scene.camera;
+    camera.set_film_size(w, h);
     std::atomic<uint64_t> total_rays{0}, total_samples{0};
     std::atomic<bool> stopped{false};
 
@@ -35,7 +38,7 @@ PassStats run_pass(const Scene& scene, Film& film, uint32_t first_sample, int sp
                 for (int s = 0; s < spp; ++s) {
                     sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
                     vec2 jitter = sampler.next_2d();  // box filter: uniform over the pixel
-                    Ray ray = scene.camera.generate_ray(vec2(float(x), float(y)) + jitter);
+                    Ray ray = camera.generate_ray(vec2(float(x), float(y)) + jitter);
                     vec3 L = integrator.template Li<IndependentSampler, DiffuseOnly>(ray, sampler, ps);
                     film.add_sample(ivec2(x, y), L);
                     ++samples;

@@ -19,7 +19,8 @@ class Renderer {
 public:
     static constexpr int kTileSize = 16;
 
-    // Renders samples [first_sample, first_sample + spp) of every pixel. `threads` <= 0 uses all
+    // Renders samples [first_sample, first_sample + spp) of every pixel, through the scene's camera
+    // set to the film's size. `threads` <= 0 uses all
     // cores. Returns early (completed = false) when *cancel becomes true; tiles already done stay.
     static PassStats render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
                                  const std::atomic<bool>* cancel = nullptr);

@@ -25,13 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-bool same_emitters(const std::vector<AreaEmitter>& a, const std::vector<AreaEmitter>& b) {
-    if (a.size() != b.size()) return false;
-    for (size_t i = 0; i < a.size(); ++i)
-        if (a[i].radiance != b[i].radiance) return false;
-    return true;
-}
-
 template <class T>
 void decimate(std::vector<T>& v) {
     size_t n = 0;
@@ -57,12 +50,12 @@ double mean_relative_change(const std::vector<float>& a, const std::vector<float
 
 // Edits the front end has handed over and the worker has not yet applied.
 struct RenderSession::Pending {
-    std::shared_ptr<Scene> scene;  // non-null: switch to this scene (with its own parameters)
+    std::shared_ptr<const Scene> scene;  // non-null: switch to this scene (with its own parameters)
     bool has_params = false;
     SceneParams params;
 };
 
-RenderSession::RenderSession(std::shared_ptr<Scene> scene, const SessionOptions& opt) : opt_(opt) {
+RenderSession::RenderSession(std::shared_ptr<const Scene> scene, const SessionOptions& opt) : opt_(opt) {
     opt_.spp_per_pass = std::max(1, opt_.spp_per_pass);
     opt_.preview_scale = std::max(1, opt_.preview_scale);
     threads_ = opt.threads;
@@ -106,7 +99,7 @@ uint64_t RenderSession::update(const SceneParams& p) {
     return gen;
 }
 
-uint64_t RenderSession::replace_scene(std::shared_ptr<Scene> scene) {
+uint64_t RenderSession::replace_scene(std::shared_ptr<const Scene> scene) {
     uint64_t gen;
     {
         std::lock_guard<std::mutex> lock(mu_);
@@ -243,7 +236,7 @@ void RenderSession::worker() {
         }
     }
     Film full, preview;
-    std::shared_ptr<Scene> scene;
+    std::shared_ptr<const Scene> scene;
     uint64_t gen = 0;
     int passes = 0, preview_passes = 0;
     bool need_preview = false;
@@ -281,19 +274,18 @@ void RenderSession::worker() {
         }
 
         if (pending) {
-            // Apply the edits. The front end reads only the geometry of scene_, which none of
-            // this touches.
+            // Apply the edits: a new immutable scene, built here (materials may take time to
+            // prepare), then published as the front end's snapshot.
             if (pending->scene) scene = pending->scene;
+            std::string error;
             if (pending->has_params) {
-                const SceneParams& p = pending->params;
-                bool relight = !same_emitters(scene->emitters, p.emitters);
-                scene->camera = p.camera;
-                scene->settings = p.settings;
-                scene->materials = p.materials;
-                if (relight) {
-                    scene->emitters = p.emitters;
-                    scene->lights.build(scene->mesh, scene->shapes, scene->emitters);  // caches radiance
+                try {
+                    scene = scene->with_params(pending->params);
+                } catch (const std::exception& e) {
+                    error = e.what();  // keep rendering the last good parameters
                 }
+                std::lock_guard<std::mutex> lock(mu_);
+                scene_ = scene;
             }
             full_w = scene->settings.width;
             full_h = scene->settings.height;
@@ -318,6 +310,7 @@ void RenderSession::worker() {
             stats_ = SessionStats();
             stats_.generation = gen;
             stats_.preview = true;
+            stats_.error = error;
             job = next_job();
         } else {
             std::lock_guard<std::mutex> lock(mu_);
@@ -329,8 +322,6 @@ void RenderSession::worker() {
         Film& film = is_preview ? preview : full;
         const int spp = is_preview ? 1 : opt_.spp_per_pass;
         const int index = is_preview ? preview_passes : passes;
-        // The camera's per-ray constants depend on the film size; the worker owns the camera.
-        scene->camera.set_film_size(film.width(), film.height());
         last_tick = Clock::now();
         PassStats ps = Renderer::render_pass(*scene, film, uint32_t(index) * uint32_t(spp), spp, threads_.load(), &cancel_);
         double dt = seconds_since(last_tick);

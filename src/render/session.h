@@ -2,20 +2,21 @@
 // A render session: one worker thread that runs passes of the Renderer until told otherwise, for an
 // interactive front end that must never wait for a pass.
 //
-// Threads and ownership. The worker owns the Scene's mutable state (camera, settings, materials,
-// emitters, lights) and the films; the front end never touches them. It keeps its own copy of that
-// state (SceneParams), edits the copy and hands it over with update(): the worker is cancelled
-// (Renderer::render_pass checks the flag per tile, so it stops within one tile per thread), applies
-// the copy, clears the films and starts again. The front end only ever takes a mutex for a swap of
-// pointers or a few scalars. The geometry (mesh, shapes, accelerator) is immutable after
-// Scene::finalize and may be read by the front end at any time (scene()), for picking.
+// Threads and ownership. Scenes are immutable (scene/scene.h) and shared as shared_ptr<const Scene>:
+// the front end and the worker never write to the same object. The front end keeps its own copy of
+// the parameters (SceneParams), edits it and hands it over with update(); the worker is cancelled
+// (Renderer::render_pass checks the flag per tile, so it stops within one tile per thread), builds
+// the new scene from the old one (Scene::with_params, which shares the geometry and accelerator and
+// prepares materials off the window's thread), swaps it in under the lock, clears the films and
+// starts again. The front end reads the scene through snapshots (scene()), for picking and names,
+// and only ever takes the mutex for a swap of pointers or a few scalars.
 //
 // What the worker renders after a restart: one preview pass at 1/preview_scale of the resolution,
 // shown at once, then full-resolution passes. While the front end says the user is interacting
 // (set_interactive, e.g. during a camera drag) it keeps rendering previews only, so each camera
-// change costs 1/16 of a pass (less when preview_budget asks for it). Full passes accumulate; each completed pass is resolved to RGB and
-// published. A cancelled pass is discarded (its film is cleared by the restart), so the film never
-// holds a pixel with the same sample index twice.
+// change costs 1/16 of a pass (less when preview_budget asks for it). Full passes accumulate; each
+// completed pass is resolved to RGB and published. A cancelled pass is discarded (its film is
+// cleared by the restart), so the film never holds a pixel with the same sample index twice.
 #include <atomic>
 #include <condition_variable>
 #include <functional>
@@ -28,16 +29,6 @@
 #include "scene/scene.h"
 
 namespace candela {
-
-// Everything the image depends on that can change without rebuilding the geometry.
-struct SceneParams {
-    Camera camera;
-    RenderSettings settings;
-    std::vector<Material> materials;
-    std::vector<AreaEmitter> emitters;
-
-    static SceneParams from(const Scene& s) { return {s.camera, s.settings, s.materials, s.emitters}; }
-};
 
 // How the render threads share the CPU with the rest of the machine (Linux; elsewhere Normal).
 //   Normal  the default priority of the process
@@ -78,6 +69,7 @@ struct SessionStats {
     double msamples_per_s = 0, mrays_per_s = 0;  // over the full passes of this generation
     uint64_t nonfinite = 0;   // NaN/Inf samples dropped by the film (Film::nonfinite_count)
     bool paused = false, idle = false, preview = false;
+    std::string error;        // why the last update() was refused (the render goes on without it)
     // Convergence: after every full pass k >= 2, the mean over pixels of |L_k - L_{k-1}| / (L_{k-1} + eps)
     // on luminance, with the time it was measured (seconds since the restart).
     std::vector<float> change, change_time;
@@ -85,22 +77,25 @@ struct SessionStats {
 
 class RenderSession {
 public:
-    // Starts the worker at once. The scene must be finalized.
-    RenderSession(std::shared_ptr<Scene> scene, const SessionOptions& opt);
+    // Starts the worker at once.
+    RenderSession(std::shared_ptr<const Scene> scene, const SessionOptions& opt);
     // Cancels the pass in flight and joins the worker (at most one tile per thread of waiting).
     ~RenderSession();
     RenderSession(const RenderSession&) = delete;
     RenderSession& operator=(const RenderSession&) = delete;
 
-    // The scene's geometry, read-only, for picking. Its camera, settings, materials and emitters
-    // belong to the worker: read the SceneParams copy instead. Valid until replace_scene.
+    // A snapshot of the scene being rendered (or of the one replace_scene handed over). Immutable:
+    // any thread may read all of it. Parameters sent by update() appear in it once the worker has
+    // taken them.
     std::shared_ptr<const Scene> scene() const;
 
     // Every edit that changes the image goes through here: cancels the pass in flight and restarts
-    // with `p`. Returns at once; the new generation number is returned.
+    // with `p`, which must fit the scene's geometry (Scene::with_params; when it does not, the worker
+    // keeps the old parameters and SessionStats::error says why). Returns at once; the new
+    // generation number is returned.
     uint64_t update(const SceneParams& p);
     // A new scene (e.g. a dropped file), with its own parameters. Restarts.
-    uint64_t replace_scene(std::shared_ptr<Scene> scene);
+    uint64_t replace_scene(std::shared_ptr<const Scene> scene);
     // Clears the film and starts again with the same parameters.
     uint64_t reset();
 
@@ -151,7 +146,7 @@ private:
     bool interactive_ = false;
     std::unique_ptr<Pending> pending_;  // edits not yet seen by the worker
     uint64_t generation_ = 0;           // latest requested generation
-    std::shared_ptr<Scene> scene_;      // the worker's scene (geometry shared with the front end)
+    std::shared_ptr<const Scene> scene_;  // the snapshot the worker renders
     SessionImage front_;                // newest published image (swapped out by take_image)
     SessionImage full_;                 // newest full-resolution image
     uint64_t sequence_ = 0;

@@ -58,8 +58,8 @@ std::vector<CornellPart> cornell_box_parts() {
     return parts;
 }
 
-Scene make_cornell_box() {
-    Scene s;
+SceneDescription make_cornell_box() {
+    SceneDescription s;
     s.source = "<built-in Cornell box>";
     s.materials = {
         {"white", DiffuseBsdf{kCornellWhite}, false},

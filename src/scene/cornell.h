@@ -10,7 +10,7 @@ namespace candela {
 // normal points into the room or out of the blocks (the BSDFs are one-sided, as in Mitsuba), and
 // the 130 x 105 mm light sits 0.1 mm under the ceiling, facing down.
 // scenes/cornell-box/ holds the same geometry as Mitsuba XML + OBJ (tests check they agree).
-Scene make_cornell_box();
+SceneDescription make_cornell_box();
 
 // The raw geometry, for the OBJ exporter and the tests: name, material, quads (4 corners each).
 struct CornellPart {

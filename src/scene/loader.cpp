@@ -5,7 +5,7 @@
 
 namespace candela {
 
-Scene load_scene(const std::string& path, const Defines& defines) {
+SceneDescription load_scene(const std::string& path, const Defines& defines) {
     // A directory opens like a file and fails only when read, with a stream error that names
     // neither the file nor the problem.
     std::error_code ec;

@@ -285,7 +285,7 @@ std::vector<vec3> compute_vertex_normals(const std::vector<vec3>& positions, con
     return n;
 }
 
-void set_default_camera(Scene& scene) {
+void set_default_camera(SceneDescription& scene) {
     AABB b = scene.mesh.bounds();
     vec3 c(0.f);
     float r = 1.f;
@@ -306,9 +306,9 @@ void set_default_camera(Scene& scene) {
     scene.camera.far_clip = 10.f * (d + r);
 }
 
-Scene load_obj_scene(const std::string& path) {
+SceneDescription load_obj_scene(const std::string& path) {
     ObjData obj = read_obj(path, true);
-    Scene scene;
+    SceneDescription scene;
     scene.source = path;
     scene.warnings = obj.warnings;
 

@@ -45,8 +45,8 @@ std::vector<vec3> compute_vertex_normals(const std::vector<vec3>& positions, con
 }  // namespace candela
 
 namespace candela {
-struct Scene;
+struct SceneDescription;
 // The camera of a scene file that has none: it looks along +z at the centre of the mesh's bounds,
 // from far enough that a 45 degree fov (on the smaller image axis) frames the bounding sphere.
-void set_default_camera(Scene& scene);
+void set_default_camera(SceneDescription& scene);
 }  // namespace candela

@@ -4,8 +4,9 @@
 
 namespace candela {
 
-uint32_t Scene::add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
-                          const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter) {
+uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<vec3>& positions,
+                                     const std::vector<vec3>& normals, const std::vector<uvec3>& triangles,
+                                     uint32_t material, int32_t emitter) {
     Shape s;
     s.name = name;
     s.material = material;
@@ -29,18 +30,91 @@ uint32_t Scene::add_shape(const std::string& name, const std::vector<vec3>& posi
     return shape_index;
 }
 
-void Scene::finalize(const std::string& accel_name) {
+namespace {
+
+// The checks every parameter set must pass against the geometry it is rendered with.
+void check_params(const std::string& source, const std::vector<Shape>& shapes, const SceneParams& p) {
+    check_film_size(p.settings.width, p.settings.height, source);
+    if (p.settings.max_depth < -1) throw Error(source, 0, "max depth must be -1 (unbounded) or >= 0");
+    if (p.settings.rr_depth < 0) throw Error(source, 0, "Russian roulette depth must be >= 0");
+    for (const Shape& s : shapes) {
+        if (s.material >= p.materials.size())
+            throw Error(source, 0, "shape '" + s.name + "' names material " + std::to_string(s.material) + " of " +
+                                       std::to_string(p.materials.size()));
+        if (s.emitter >= 0 && size_t(s.emitter) >= p.emitters.size())
+            throw Error(source, 0, "shape '" + s.name + "' names emitter " + std::to_string(s.emitter) + " of " +
+                                       std::to_string(p.emitters.size()));
+    }
+}
+
+std::vector<Material> prepared(std::vector<Material> materials) {
+    for (Material& m : materials) prepare(m.bsdf);
+    return materials;
+}
+
+// The camera ready for the scene's own film (a renderer of another film size sets its own copy).
+Camera sized(Camera c, const RenderSettings& st) {
+    c.set_film_size(st.width, st.height);
+    return c;
+}
+
+bool same_emitters(const std::vector<AreaEmitter>& a, const std::vector<AreaEmitter>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (a[i].radiance != b[i].radiance) return false;
+    return true;
+}
+
+}  // namespace
+
+Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std::shared_ptr<const Accel> accel_,
+             std::shared_ptr<const LightSet> lights_, const SceneParams& p, std::vector<std::string> warnings_)
+    : source(std::move(source_)),
+      geometry(std::move(geometry_)),
+      mesh(geometry->mesh),
+      shapes(geometry->shapes),
+      accel(std::move(accel_)),
+      light_set(std::move(lights_)),
+      lights(*light_set),
+      camera(sized(p.camera, p.settings)),
+      settings(p.settings),
+      materials(prepared(p.materials)),
+      emitters(p.emitters),
+      warnings(std::move(warnings_)) {}
+
+std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::string& accel_name) {
+    Mesh& mesh = desc.mesh;
     for (size_t i = 0; i < mesh.positions.size(); ++i)
         if (!all_finite(mesh.positions[i]))
-            throw Error(source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+            throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
     for (const uvec3& t : mesh.triangles)
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
-            throw Error(source, 0, "triangle index out of range");
+            throw Error(desc.source, 0, "triangle index out of range");
     if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
-    check_film_size(settings.width, settings.height, source);
-    camera.set_film_size(settings.width, settings.height);
-    accel = make_accel(accel_name, mesh);
-    lights.build(mesh, shapes, emitters);
+    SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters)};
+    check_params(desc.source, desc.shapes, params);
+
+    auto geometry = std::make_shared<Geometry>();
+    geometry->mesh = std::move(desc.mesh);
+    geometry->shapes = std::move(desc.shapes);
+    geometry->bounds = geometry->mesh.bounds();
+    std::shared_ptr<const Accel> accel = make_accel(accel_name, geometry->mesh);
+    auto lights = std::make_shared<LightSet>();
+    lights->build(geometry->mesh, geometry->shapes, params.emitters);
+    return std::shared_ptr<const Scene>(
+        new Scene(std::move(desc.source), std::move(geometry), std::move(accel), std::move(lights), params,
+                  std::move(desc.warnings)));
+}
+
+std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
+    check_params(source, shapes, p);
+    std::shared_ptr<const LightSet> lights_for = light_set;
+    if (!same_emitters(emitters, p.emitters)) {
+        auto rebuilt = std::make_shared<LightSet>();
+        rebuilt->build(mesh, shapes, p.emitters);
+        lights_for = std::move(rebuilt);
+    }
+    return std::shared_ptr<const Scene>(new Scene(source, geometry, accel, std::move(lights_for), p, warnings));
 }
 
 SurfaceInteraction Scene::interaction(const Hit& hit) const {

@@ -1,4 +1,15 @@
 #pragma once
+// A scene exists in two forms (pbrt-v4 keeps its BasicScene apart from the aggregate for the same
+// reason):
+//   SceneDescription  what a loader produces: plain, mutable, movable data, nothing derived.
+//   Scene             the built scene the renderer reads: geometry, accelerator and light set,
+//                     plus the parameters (camera, settings, materials, emitters). Immutable once
+//                     built and reached only through shared_ptr<const Scene>, so any number of
+//                     threads may read one at the same time; an edit builds a new Scene
+//                     (with_params) that shares the unchanged parts with the old one.
+// The parts that hold pointers into another part (the accelerator and the light set point into the
+// mesh) are built together by build_scene and shared by pointer afterwards, never copied or moved.
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,10 +33,18 @@ struct RenderSettings {
     SamplingMode sampling = SamplingMode::Mis;
 };
 
-// A loaded scene. Loaders fill the public data; finalize() derives the acceleration structure,
-// the light set and the camera's film constants. After finalize() the scene is read-only during
-// rendering and is shared by all render threads.
-struct Scene {
+// Everything the image depends on that can change without rebuilding the geometry: what the viewer
+// edits. Materials and emitters are indexed by Shape::material and Shape::emitter, so an edit keeps
+// their number.
+struct SceneParams {
+    Camera camera;
+    RenderSettings settings;
+    std::vector<Material> materials;
+    std::vector<AreaEmitter> emitters;
+};
+
+// A scene as loaded, before anything is derived from it. Loaders fill it; build_scene consumes it.
+struct SceneDescription {
     std::string source;                  // file it came from ("<built-in Cornell box>" otherwise)
     Mesh mesh;
     std::vector<Shape> shapes;
@@ -35,31 +54,76 @@ struct Scene {
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
 
-    std::unique_ptr<Accel> accel;
-    LightSet lights;
-
-    // Build the accelerator (by name, see make_accel) and lights; validates the geometry.
-    void finalize(const std::string& accel_name = "auto");
-
     // Appends a shape made of the given triangles (world space). Returns its index.
     uint32_t add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
                        const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter);
+};
+
+// The immutable triangle geometry, shared by every Scene built from one description.
+struct Geometry {
+    Mesh mesh;
+    std::vector<Shape> shapes;
+    AABB bounds;
+};
+
+class Scene {
+public:
+    // The shared parts come first: members are destroyed in reverse order, so the geometry outlives
+    // the accelerator and the light set that point into it.
+    const std::string source;
+    const std::shared_ptr<const Geometry> geometry;
+    const Mesh& mesh;                  // geometry->mesh
+    const std::vector<Shape>& shapes;  // geometry->shapes
+    const std::shared_ptr<const Accel> accel;
+    const std::shared_ptr<const LightSet> light_set;
+    const LightSet& lights;            // *light_set
+
+    // The parameters this scene renders with (the camera set to the settings' film size, materials
+    // prepared: their derived tables built).
+    const Camera camera;
+    const RenderSettings settings;
+    const std::vector<Material> materials;
+    const std::vector<AreaEmitter> emitters;
+    const std::vector<std::string> warnings;
+
+    Scene(const Scene&) = delete;
+    Scene& operator=(const Scene&) = delete;
+
+    // This scene with other parameters: shares the geometry and the accelerator, and the light set
+    // when the emitters are unchanged (else rebuilds it, which caches their radiance). Prepares the
+    // materials (e.g. the plastic coat tables) on the calling thread: call it where that may take
+    // time, the render worker, not the window. Throws Error when `p` does not fit the geometry
+    // (another number of materials or emitters, an impossible film size).
+    std::shared_ptr<const Scene> with_params(const SceneParams& p) const;
+    SceneParams params() const { return {camera, settings, materials, emitters}; }
 
     // Surface data at a hit, with the error bound of the point.
     SurfaceInteraction interaction(const Hit& hit) const;
 
-    // What the loaded scene holds in memory, by part. The mesh stores normals only where the file
-    // gives them and the light maps only when there are emitters, so a scene pays for what it uses.
+    // What the scene holds in memory, by part. The mesh stores normals only where the file gives
+    // them and the light maps only when there are emitters, so a scene pays for what it uses.
     struct Memory {
         size_t triangles = 0;
         size_t mesh = 0, accel = 0, lights = 0;  // bytes
         size_t total() const { return mesh + accel + lights; }
     };
     Memory memory() const;
+
+private:
+    friend std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::string& accel_name);
+    Scene(std::string source, std::shared_ptr<const Geometry> geometry, std::shared_ptr<const Accel> accel,
+          std::shared_ptr<const LightSet> lights, const SceneParams& p, std::vector<std::string> warnings);
 };
 
-// Loads a scene by its extension: .xml (Mitsuba 3 subset) or .obj (OBJ + MTL). `defines` are
-// name=value pairs that override the XML's <default> values. Throws Error with file:line.
-Scene load_scene(const std::string& path, const std::vector<std::pair<std::string, std::string>>& defines = {});
+// Validates the description (finite vertices, indices in range, film size, material and emitter
+// indices), builds the accelerator (by name, see make_accel) and the light set, and prepares the
+// materials. Throws Error naming the source.
+std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::string& accel_name = "auto");
+
+// Loads a scene description by its extension: .xml (Mitsuba 3 subset) or .obj (OBJ + MTL).
+// `defines` are name=value pairs that override the XML's <default> values. Throws Error with
+// file:line.
+SceneDescription load_scene(const std::string& path,
+                            const std::vector<std::pair<std::string, std::string>>& defines = {});
 
 }  // namespace candela

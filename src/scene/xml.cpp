@@ -111,7 +111,7 @@ public:
         for (const auto& d : defines) vars_[d.first] = d.second;
     }
 
-    Scene load();
+    SceneDescription load();
 
     // ---- helpers the factories use ----
     const std::string& path() const { return path_; }
@@ -171,7 +171,7 @@ private:
     // refs, so a ref cycle or a deep nest must be an error before it is a stack overflow.
     std::vector<pugi::xml_node> bsdf_stack_;
     static constexpr size_t kMaxBsdfNesting = 64;
-    Scene scene_;
+    SceneDescription scene_;
     int shape_counter_ = 0;
 };
 
@@ -800,7 +800,7 @@ void XmlLoader::load_shape(pugi::xml_node n) {
     scene_.add_shape(name, g.positions, g.normals, g.triangles, material, emitter);
 }
 
-Scene XmlLoader::load() {
+SceneDescription XmlLoader::load() {
     std::ifstream in(path_, std::ios::binary);
     if (!in) throw Error(path_, 0, "cannot open file");
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -891,7 +891,7 @@ Scene XmlLoader::load() {
 
 }  // namespace
 
-Scene load_mitsuba_xml(const std::string& path, const Defines& defines) {
+SceneDescription load_mitsuba_xml(const std::string& path, const Defines& defines) {
     XmlLoader loader(path, defines);
     return loader.load();
 }

@@ -38,10 +38,6 @@ CANDELA_HAS_MEMBER(ext_ior)
 CANDELA_HAS_MEMBER(alpha)
 CANDELA_HAS_MEMBER(nonlinear)
 #undef CANDELA_HAS_MEMBER
-template <class T, class = void>
-struct has_prepare : std::false_type {};
-template <class T>
-struct has_prepare<T, std::void_t<decltype(std::declval<T&>().prepare())>> : std::true_type {};
 
 bool ior(const char* label, float& v) {
     bool changed = ImGui::DragFloat(label, &v, 0.005f, 1.f, 4.f, "%.4f");
@@ -70,9 +66,8 @@ bool edit_bsdf(T& b) {
     if constexpr (has_nonlinear<T, bool>::value)
         any = true, changed |= ImGui::Checkbox("nonlinear", &b.nonlinear);
     if (!any) ImGui::TextDisabled("(no editable parameters)");
-    // Derived data (e.g. the plastic coat's tables) must follow the parameters.
-    if constexpr (has_prepare<T>::value)
-        if (changed) b.prepare();
+    // Derived data (the plastic coat's tables) is not computed here: the render worker prepares
+    // the materials when it builds the edited scene (Scene::with_params), off the window's thread.
     return changed;
 }
 

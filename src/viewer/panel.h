@@ -13,8 +13,8 @@ const char* bsdf_type_name(const Bsdf& b);
 // to edit_bsdf(T&): a generic template that shows exactly the parameters type T has (found by their
 // names: albedo, diffuse_reflectance, specular_reflectance, eta, k, int_ior, alpha, ...), so a new
 // BSDF with conventional parameter names needs no viewer code; one with unusual parameters gets a
-// non-template overload, which overload resolution prefers. Calls T::prepare() after an edit when
-// the type has one (derived tables).
+// non-template overload, which overload resolution prefers. Derived data (tables) is left to
+// the render worker, which prepares the materials of every scene it builds.
 bool edit_material(Material& m);
 
 // Radiance of an area light (RGB, may exceed 1).

@@ -90,7 +90,7 @@ public:
 
 private:
     void open_window(int image_w, int image_h);
-    void switch_scene(std::shared_ptr<Scene> scene);
+    void switch_scene(std::shared_ptr<const Scene> scene);
     void layout();
     void camera_input();
     void camera_changed();
@@ -113,7 +113,7 @@ private:
     std::unique_ptr<DisplayProgram> program_, saver_;
     std::unique_ptr<RenderSession> session_;
 
-    std::shared_ptr<const Scene> scene_;  // geometry only: picking, names, bounds
+    std::shared_ptr<const Scene> scene_;  // immutable snapshot: picking, names, bounds
     SceneParams params_;                   // the window's copy of what the worker renders
     CameraController camera_;
     SessionImage image_;                   // on screen
@@ -150,7 +150,7 @@ private:
 
     // Background work: a scene being loaded (dropped file), files being written.
     std::vector<std::string> dropped_;
-    std::future<std::shared_ptr<Scene>> loading_;
+    std::future<std::shared_ptr<const Scene>> loading_;
     std::string loading_path_;
     std::vector<std::future<std::string>> saving_;
 
@@ -176,9 +176,9 @@ private:
 };
 
 Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
-    std::shared_ptr<Scene> scene = prepare_scene_shared(opt.scene, opt.overrides);
-    params_ = SceneParams::from(*scene);
-    camera_.reset(scene->camera, scene->mesh.bounds());
+    std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
+    params_ = scene->params();
+    camera_.reset(scene->camera, scene->geometry->bounds);
     scene_ = scene;
 
     glfwSetErrorCallback(glfw_error);
@@ -282,10 +282,9 @@ void Viewer::open_window(int image_w, int image_h) {
     imgui_ready_ = true;
 }
 
-void Viewer::switch_scene(std::shared_ptr<Scene> scene) {
-    // Read what the window needs before the worker owns the scene's mutable state.
-    params_ = SceneParams::from(*scene);
-    camera_.reset(scene->camera, scene->mesh.bounds());
+void Viewer::switch_scene(std::shared_ptr<const Scene> scene) {
+    params_ = scene->params();
+    camera_.reset(scene->camera, scene->geometry->bounds);
     scene_ = scene;
     sent_gen_ = session_->replace_scene(std::move(scene));
     last_sent_ = now();
@@ -444,7 +443,7 @@ void Viewer::poll_background_work() {
         ov.width.reset();
         ov.height.reset();
         loading_path_ = path;
-        loading_ = std::async(std::launch::async, [path, ov] { return prepare_scene_shared(path, ov); });
+        loading_ = std::async(std::launch::async, [path, ov] { return prepare_scene(path, ov); });
         set_status("loading " + path + " ...", false);
     }
 }
@@ -497,7 +496,7 @@ void Viewer::panel() {
     ImGui::PushItemWidth(-110.f);
     ImGui::TextUnformatted(scene_->source.c_str());
     ImGui::TextDisabled("%dx%d, %zu triangles, %zu lights", params_.settings.width, params_.settings.height,
-                        scene_->mesh.triangle_count(), scene_->emitters.size());
+                        scene_->mesh.triangle_count(), params_.emitters.size());
     if (!status_.empty()) {
         if (status_error_) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.4f, 0.35f, 1.f));
         ImGui::TextWrapped("%s", status_.c_str());
@@ -573,7 +572,7 @@ void Viewer::panel() {
             camera_changed();
         }
         if (ImGui::Button("Reset camera")) {
-            camera_.reset(camera_.initial(), scene_->mesh.bounds());
+            camera_.reset(camera_.initial(), scene_->geometry->bounds);
             camera_changed();
         }
         if (ImGui::IsItemHovered())
