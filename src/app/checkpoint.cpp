@@ -226,16 +226,25 @@ uint64_t scene_fingerprint(const Scene& scene) {
         }
     }
 
-    // The camera is probed by its rays, which depend on every camera parameter and the film size.
+    // The camera is probed by its rays, which depend on every camera parameter (type, fov, clip
+    // planes, principal point, aperture through off-centre lens samples, focus distance, full
+    // film and crop window) and the image size; the crop offset also moves the sampler's pixels.
+    const Camera& cam = scene.camera;
+    h.u64(uint64_t(cam.type));
+    h.u64(cam.needs_lens_sample());
+    const ivec2 seed_px = cam.sampler_pixel(ivec2(0));
+    h.u64(uint64_t(uint32_t(seed_px.x)) << 32 | uint32_t(seed_px.y));
     const float fx[] = {0.f, 0.31f, 0.5f, 1.f}, fy[] = {0.f, 0.77f, 0.5f, 1.f};
+    const vec2 lens[] = {vec2(0.5f), vec2(0.13f, 0.71f), vec2(0.9f, 0.35f)};
     for (float x : fx)
-        for (float y : fy) {
-            Ray r = scene.camera.generate_ray(vec2(x * float(st.width), y * float(st.height)));
-            h.v3(r.o);
-            h.v3(r.d);
-            h.f32(r.tmin);
-            h.f32(r.tmax);
-        }
+        for (float y : fy)
+            for (vec2 l : lens) {
+                Ray r = cam.generate_ray(ivec2(0), vec2(x * float(st.width), y * float(st.height)), l);
+                h.v3(r.o);
+                h.v3(r.d);
+                h.f32(r.tmin);
+                h.f32(r.tmax);
+            }
     return h.digest();
 }
 

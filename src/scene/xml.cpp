@@ -11,6 +11,7 @@
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
+#include "scene/sensors.h"
 
 namespace candela {
 
@@ -172,6 +173,7 @@ private:
     std::vector<pugi::xml_node> bsdf_stack_;
     static constexpr size_t kMaxBsdfNesting = 64;
     SceneDescription scene_;
+    FilmDesc film_;  // the sensor's film, while the sensor is read
     int shape_counter_ = 0;
 };
 
@@ -396,17 +398,7 @@ void XmlLoader::load_integrator(pugi::xml_node n) {
 void XmlLoader::load_film(pugi::xml_node n) {
     Object o = read_object(n, "film");
     if (o.type != "hdrfilm") throw error(n, "unsupported film type '" + o.type + "' (candela supports: hdrfilm)");
-    int w = o.params.get_int("width", 768), h = o.params.get_int("height", 576);
-    if (w <= 0) throw o.params.error("width", "film width must be positive");
-    if (h <= 0) throw o.params.error("height", "film height must be positive");
-    // Output format choices that do not change the rendered values.
-    std::string pf = o.params.get_string("pixel_format", "rgb");
-    if (pf != "rgb" && pf != "rgba") throw o.params.error("pixel_format", "unsupported pixel_format '" + pf + "' (rgb or rgba)");
-    std::string cf = o.params.get_string("component_format", "float16");
-    if (cf != "float16" && cf != "float32")
-        throw o.params.error("component_format", "unsupported component_format '" + cf + "' (float16 or float32)");
-    std::string ff = o.params.get_string("file_format", "openexr");
-    if (ff != "openexr") throw o.params.error("file_format", "unsupported file_format '" + ff + "' (openexr)");
+    film_ = make_hdrfilm(o.params);
     bool have_filter = false;
     for (Nested& c : o.nested) {
         if (c.tag != "rfilter") continue;
@@ -418,8 +410,6 @@ void XmlLoader::load_film(pugi::xml_node n) {
         c.used = have_filter = true;
     }
     finish(o);
-    scene_.settings.width = w;
-    scene_.settings.height = h;
 }
 
 void XmlLoader::load_sampler(pugi::xml_node n) {
@@ -436,35 +426,11 @@ void XmlLoader::load_sampler(pugi::xml_node n) {
 
 void XmlLoader::load_sensor(pugi::xml_node n) {
     Object o = read_object(n, "sensor");
-    if (o.type != "perspective") throw error(n, "unsupported sensor type '" + o.type + "' (candela supports: perspective)");
-    Camera cam;
-    if (o.params.has("fov")) {
-        cam.fov_deg = o.params.get_float("fov", 0.f);
-        if (!(cam.fov_deg > 0.f && cam.fov_deg < 180.f)) throw o.params.error("fov", "fov must be in (0, 180) degrees");
-        std::string axis = o.params.get_string("fov_axis", "x");
-        if (axis == "x") cam.fov_axis = FovAxis::X;
-        else if (axis == "y") cam.fov_axis = FovAxis::Y;
-        else if (axis == "diagonal") cam.fov_axis = FovAxis::Diagonal;
-        else if (axis == "smaller") cam.fov_axis = FovAxis::Smaller;
-        else if (axis == "larger") cam.fov_axis = FovAxis::Larger;
-        else throw o.params.error("fov_axis", "unknown fov_axis '" + axis + "' (x, y, diagonal, smaller or larger)");
-    } else {
-        // Mitsuba's default: a 50 mm lens on a 36 x 24 mm film, measured on the diagonal.
-        cam.fov_deg = glm::degrees(2.f * std::atan(std::sqrt(36.f * 36.f + 24.f * 24.f) / (2.f * 50.f)));
-        cam.fov_axis = FovAxis::Diagonal;
-        if (o.params.has("fov_axis")) o.params.get_string("fov_axis", "");  // ignored without fov, as in Mitsuba
-    }
-    cam.near_clip = o.params.get_float("near_clip", 1e-2f);
-    cam.far_clip = o.params.get_float("far_clip", 1e4f);
-    if (!(cam.near_clip > 0.f)) throw o.params.error("near_clip", "near_clip must be positive");
-    if (!(cam.far_clip > cam.near_clip)) throw o.params.error("far_clip", "far_clip must be greater than near_clip");
-    cam.to_world = o.params.get_transform("to_world", mat4(1.f));
-    for (int col = 0; col < 3; ++col)
-        if (std::abs(glm::dot(vec3(cam.to_world[col]), vec3(cam.to_world[col])) - 1.f) > 1e-3f)
-            throw o.params.error("to_world", "the sensor's to_world must not scale (Mitsuba rejects it too)");
+    if (!is_supported_sensor(o.type))
+        throw error(n, "unsupported sensor type '" + o.type + "' (candela supports: " + supported_sensors() + ")");
+    Camera cam = make_sensor(o.type, o.params);
 
-    scene_.settings.width = 768;  // Mitsuba's film and sampler defaults, when those are absent
-    scene_.settings.height = 576;
+    film_ = FilmDesc();  // Mitsuba's film and sampler defaults, when those are absent
     scene_.settings.spp = 4;
     scene_.settings.seed = 0;
     bool film = false, sampler = false;
@@ -480,6 +446,10 @@ void XmlLoader::load_sensor(pugi::xml_node n) {
         }
     }
     finish(o);
+    ivec2 image = apply_film(film_, cam);
+    scene_.settings.width = image.x;
+    scene_.settings.height = image.y;
+    scene_.settings.alpha = film_.alpha;
     scene_.camera = cam;
 }
 
