@@ -9,6 +9,7 @@
 //    film, whatever the thread count.
 // tests/data/cameras/make_camera_data.py made the data (its header says how).
 #include <gtest/gtest.h>
+#include <tinyexr.h>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -17,6 +18,7 @@
 #include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/loaders.h"
+#include "support/run.h"
 #include "support/stats.h"
 
 using namespace candela;
@@ -348,4 +350,112 @@ TEST(Cameras, ParametersAsMitsubaReadsThem) {
     EXPECT_EQ(t.camera.type, CameraType::ThinLens);
     EXPECT_EQ(t.camera.focus_distance, 1e4f);
     EXPECT_FALSE(t.camera.needs_lens_sample());
+}
+
+namespace {
+
+// An orthographic camera (extent x in [-2, 2], y in [-1, 1] on a 40 x 20 film) facing a rectangle
+// of half-width `half_w` and half-height 0.5 at z = 5. Film column of x: 20 (1 - x / 2), row of y:
+// 10 (1 - y): the rectangle's rows 5..14 are whole pixels, its columns end inside pixels 10 and 29.
+std::string coverage_scene(float half_w, const std::string& pixel_format = "rgba") {
+    return "<scene version=\"3.0.0\">\n"
+           "<sensor type=\"orthographic\"><transform name=\"to_world\"><scale x=\"2\" y=\"2\"/></transform>\n"
+           "<film type=\"hdrfilm\"><integer name=\"width\" value=\"40\"/><integer name=\"height\" value=\"20\"/>\n"
+           "<string name=\"pixel_format\" value=\"" + pixel_format + "\"/><rfilter type=\"box\"/></film></sensor>\n"
+           "<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"" + std::to_string(half_w) +
+           "\" y=\"0.5\"/><translate z=\"5\"/></transform></shape>\n</scene>\n";
+}
+
+// z of the mean alpha of the partly covered columns 10 and 29 (rows 6..13) against `expected`.
+double edge_alpha_z(const Film& f, int spp, double expected) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 6; y <= 13; ++y)
+        for (int x : {10, 29}) {
+            sum += f.alpha(x, y);
+            ++n;
+        }
+    double samples = double(n) * spp;
+    return (sum / n - expected) / std::sqrt(expected * (1 - expected) / samples);
+}
+
+}  // namespace
+
+TEST(Cameras, AlphaIsTheFractionOfCameraRaysThatHit) {
+    const int spp = 256;
+    SceneDescription d = load_text("cov.xml", coverage_scene(0.93f));
+    ASSERT_TRUE(d.settings.alpha);
+    std::shared_ptr<const Scene> scene = build_scene(d);
+    Film film(40, 20);
+    film.enable_alpha();
+    Renderer::render_pass(*scene, film, 0, spp, 0);
+    // Whole pixels inside are 1, outside 0, exactly; the edge columns are 30% covered.
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 40; ++x) {
+            bool inside = y >= 5 && y <= 14 && x >= 11 && x <= 28, outside = y <= 3 || y >= 16 || x <= 9 || x >= 30;
+            if (inside) {
+                EXPECT_EQ(film.alpha(x, y), 1.f) << x << "," << y;
+            } else if (outside) {
+                EXPECT_EQ(film.alpha(x, y), 0.f) << x << "," << y;
+            }
+        }
+    double z = edge_alpha_z(film, spp, 0.3);
+    EXPECT_LT(std::abs(z), 3.3) << "p < 0.001";  // two-sided
+    // The control: a rectangle reaching pixel 10.5 (x = 0.95) covers 50%, which the test sees.
+    SceneDescription wide = load_text("cov_wide.xml", coverage_scene(0.95f));
+    Film film2(40, 20);
+    film2.enable_alpha();
+    Renderer::render_pass(*build_scene(wide), film2, 0, spp, 0);
+    double z_control = edge_alpha_z(film2, spp, 0.3);
+    std::printf("  edge coverage 0.3: z = %.2f; control (0.5 covered) z = %.1f\n", z, z_control);
+    EXPECT_GT(std::abs(z_control), 3.3);
+}
+
+namespace {
+
+// RGBA of an EXR through tinyexr (A is 1 where the file has no alpha channel).
+std::vector<float> load_rgba(const std::string& path, int& w, int& h) {
+    float* rgba = nullptr;
+    const char* err = nullptr;
+    std::vector<float> out;
+    if (LoadEXR(&rgba, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
+        if (err) FreeEXRErrorMessage(err);
+        return out;
+    }
+    out.assign(rgba, rgba + size_t(w) * size_t(h) * 4);
+    std::free(rgba);
+    return out;
+}
+
+}  // namespace
+
+TEST(Cameras, RgbaFilmWritesAlphaAndResumesBitForBit) {
+    const std::string d = test::temp_dir("cam_rgba");
+    test::write_text(d + "/rgba.xml", coverage_scene(0.93f));
+    test::write_text(d + "/rgb.xml", coverage_scene(0.93f, "rgb"));
+    const std::string q = " --quiet --frames 6 --out ";
+    ASSERT_EQ(test::run_candela(d + "/rgba.xml" + q + d + "/full.exr").exit_code, 0);
+    ASSERT_EQ(test::run_candela(d + "/rgb.xml" + q + d + "/rgb.exr").exit_code, 0);
+    // 2 passes, checkpointed, then resumed to 6 on another thread count.
+    ASSERT_EQ(test::run_candela(d + "/rgba.xml --quiet --frames 2 --threads 1 --out " + d + "/part.exr --checkpoint " +
+                                d + "/part.ck").exit_code, 0);
+    test::RunResult r = test::run_candela(d + "/rgba.xml" + q + d + "/resumed.exr --threads 2 --checkpoint " + d +
+                                          "/part.ck --resume " + d + "/part.ck");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    int w = 0, h = 0;
+    std::vector<float> full = load_rgba(d + "/full.exr", w, h), resumed = load_rgba(d + "/resumed.exr", w, h);
+    ASSERT_EQ(w, 40);
+    ASSERT_EQ(h, 20);
+    ASSERT_EQ(full.size(), resumed.size());
+    EXPECT_TRUE(full == resumed);
+    auto alpha = [&](const std::vector<float>& img, int x, int y) { return img[(size_t(y) * 40 + size_t(x)) * 4 + 3]; };
+    EXPECT_EQ(alpha(full, 20, 10), 1.f);
+    EXPECT_EQ(alpha(full, 2, 2), 0.f);
+    std::vector<float> rgb = load_rgba(d + "/rgb.exr", w, h);
+    EXPECT_EQ(alpha(rgb, 2, 2), 1.f);  // no A channel: tinyexr's default
+    // A checkpoint without alpha does not resume an rgba render.
+    ASSERT_EQ(test::run_candela(d + "/rgb.xml --quiet --frames 2 --out " + d + "/p2.exr --checkpoint " + d + "/rgb.ck")
+                  .exit_code, 0);
+    test::RunResult bad = test::run_candela(d + "/rgba.xml" + q + d + "/x.exr --resume " + d + "/rgb.ck");
+    EXPECT_EQ(bad.exit_code, 1) << bad.output;
 }

@@ -92,6 +92,7 @@ int run_headless(const HeadlessOptions& opt) {
     if (target > std::numeric_limits<uint32_t>::max())
         throw Error("--frames x --spp-per-frame is " + std::to_string(target) + " samples per pixel, more than 2^32 - 1");
     Film film(st.width, st.height);
+    if (st.alpha) film.enable_alpha();
     int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
 
     const bool checkpointing = !opt.checkpoint.empty();
@@ -146,7 +147,8 @@ int run_headless(const HeadlessOptions& opt) {
     if (tty) std::fprintf(stderr, "\n");
     if (checkpointing && whole_passes) save("final");
 
-    Image img{film.width(), film.height(), film.resolve()};
+    Image img{film.width(), film.height(), film.resolve(), {}};
+    if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
     if (ext == ".png") write_png_headless(opt.out, img, opt.display);
     else write_linear_image(opt.out, img);
 
