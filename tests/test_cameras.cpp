@@ -519,3 +519,51 @@ TEST(Cameras, PickFollowsTheCameraTypeAndTheCrop) {
         EXPECT_EQ(a.shape, b.shape);
     }
 }
+
+namespace {
+
+std::string read_text(const std::string& path) {
+    std::ifstream f(path);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+    size_t at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) s.replace(at, from.size(), to);
+    return s;
+}
+
+}  // namespace
+
+// The checkpoint's fingerprint probes the camera by its rays: resuming with another aperture,
+// focus distance, fov axis, principal point, crop offset or orthographic extent is refused.
+TEST(Cameras, CheckpointRefusesAnotherCamera) {
+    const std::string d = test::temp_dir("cam_ck");
+    struct Edit {
+        const char *file, *from, *to;
+    } edits[] = {
+        {"thinlens.xml", "name=\"aperture_radius\" value=\"0.25\"", "name=\"aperture_radius\" value=\"0.26\""},
+        {"thinlens.xml", "name=\"focus_distance\" value=\"6\"", "name=\"focus_distance\" value=\"6.1\""},
+        {"thinlens.xml", "value=\"smaller\"", "value=\"x\""},
+        {"thinlens.xml", "name=\"crop_offset_x\" value=\"8\"", "name=\"crop_offset_x\" value=\"9\""},
+        {"perspective.xml", "name=\"principal_point_offset_y\" value=\"-0.06\"",
+         "name=\"principal_point_offset_y\" value=\"-0.05\""},
+        {"orthographic.xml", "<scale x=\"3\" y=\"3\"/>", "<scale x=\"3\" y=\"3.05\"/>"},
+    };
+    int i = 0;
+    for (const Edit& e : edits) {
+        SCOPED_TRACE(e.to);
+        const std::string base = read_text(kData + e.file), tag = d + "/" + std::to_string(i++);
+        test::write_text(tag + "a.xml", base);
+        test::write_text(tag + "b.xml", replaced(base, e.from, e.to));
+        const std::string opts = " --quiet --frames 1 --out " + tag + ".exr";
+        ASSERT_EQ(test::run_candela(tag + "a.xml" + opts + " --checkpoint " + tag + ".ck").exit_code, 0);
+        EXPECT_EQ(test::run_candela(tag + "a.xml" + opts + " --resume " + tag + ".ck").exit_code, 0);
+        test::RunResult r = test::run_candela(tag + "b.xml" + opts + " --resume " + tag + ".ck");
+        EXPECT_EQ(r.exit_code, 1) << r.output;
+        EXPECT_NE(r.output.find("another scene or other settings"), std::string::npos) << r.output;
+    }
+}
