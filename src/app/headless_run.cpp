@@ -9,6 +9,7 @@
 #include <limits>
 #include "app/checkpoint.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "film/film.h"
 #include "film/image_io.h"
 #include "headless/headless.h"
@@ -22,11 +23,14 @@ namespace {
 std::atomic<int> g_signal{0};         // the first SIGINT/SIGTERM received, 0 if none
 std::atomic<bool> g_stop_now{false};  // the render stops within a tile
 std::atomic<bool> g_finish_pass{false};  // checkpointing: the first signal waits for the pass
+std::atomic<bool> g_rendering{false};    // the scene is ready and passes run
 static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
 
 extern "C" void on_signal(int sig) {
     int none = 0;
-    if (g_signal.compare_exchange_strong(none, sig) && g_finish_pass.load()) {
+    const bool first = g_signal.compare_exchange_strong(none, sig);
+    request_interrupt();  // stops a scene load or accelerator build: they have no pass to finish
+    if (first && g_finish_pass.load() && g_rendering.load()) {
         static const char msg[] = "\ncandela: finishing the current pass for the checkpoint (signal again to stop now)\n";
         ssize_t n = ::write(STDERR_FILENO, msg, sizeof msg - 1);  // async-signal-safe, unlike stdio
         (void)n;
@@ -78,9 +82,24 @@ int run_headless(const HeadlessOptions& opt) {
     g_signal = 0;
     g_stop_now = false;
     g_finish_pass = !opt.checkpoint.empty();
+    g_rendering = false;
+    clear_interrupt();
     install_signal_handlers();
+    auto nothing_written = [&](const char* when) {
+        const int sig = g_signal.load();
+        std::string kept = opt.checkpoint.empty() ? opt.out + " left as it was"
+                                                   : opt.out + " and " + opt.checkpoint + " left as they were";
+        std::fprintf(stderr, "candela: %s %s: nothing written (%s)\n", sig == SIGTERM ? "terminated" : "interrupted",
+                     when, kept.c_str());
+        return 128 + (sig ? sig : SIGINT);
+    };
 
-    std::shared_ptr<Scene> scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    std::shared_ptr<Scene> scene_ptr;
+    try {
+        scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    } catch (const Interrupted&) {
+        return nothing_written("while loading the scene");
+    }
     const Scene& scene = *scene_ptr;
     const RenderSettings& st = scene.settings;
     if (!opt.quiet)
@@ -119,6 +138,7 @@ int run_headless(const HeadlessOptions& opt) {
         }
     };
 
+    g_rendering = true;
     const bool tty = isatty(fileno(stderr)) && !opt.quiet;
     uint64_t samples = 0, rays = 0;
     bool whole_passes = true;  // false once a pass was cut short: the film is no longer checkpointable
@@ -144,6 +164,9 @@ int run_headless(const HeadlessOptions& opt) {
     }
     double secs = std::chrono::duration<double>(clock::now() - t0).count();
     if (tty) std::fprintf(stderr, "\n");
+    // A stopped render without one whole pass must not replace an earlier good image with a
+    // black or patchy one (nor a checkpoint with an empty one).
+    if (g_signal != 0 && spp_done == 0) return nothing_written("before the first pass finished");
     if (checkpointing && whole_passes) save("final");
 
     Image img{film.width(), film.height(), film.resolve()};
