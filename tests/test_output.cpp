@@ -55,3 +55,50 @@ TEST(TimeLimit, StopsBetweenShortPasses) {
     EXPECT_NE(r.output.find("candela: time limit: "), std::string::npos) << r.output;
     EXPECT_GT(reported_spp(r.output), 0.0) << r.output;
 }
+
+namespace {
+// Width and height from a PNG's IHDR chunk.
+bool png_size(const std::string& bytes, int& w, int& h) {
+    if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0) return false;
+    auto be32 = [&](size_t at) {
+        return int((uint32_t(uint8_t(bytes[at])) << 24) | (uint32_t(uint8_t(bytes[at + 1])) << 16) |
+                   (uint32_t(uint8_t(bytes[at + 2])) << 8) | uint32_t(uint8_t(bytes[at + 3])));
+    };
+    w = be32(16);
+    h = be32(20);
+    return true;
+}
+}  // namespace
+
+// Asked for a 20000-pixel-wide PNG, the user gets it (the GL limit is 16384).
+TEST(PngOutput, WiderThanTheGlLimit) {
+    std::string d = temp_dir("png-wide");
+    RunResult r = run_candela("--width 20000 --height 2 --frames 1 --out " + d + "/wide.png");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    int w = 0, h = 0;
+    ASSERT_TRUE(png_size(read_bytes(d + "/wide.png"), w, h)) << r.output;
+    EXPECT_EQ(w, 20000);
+    EXPECT_EQ(h, 2);
+}
+
+// When GL fails, the render goes to an EXR beside the PNG, with a message and a non-zero exit.
+TEST(PngOutput, GlFailureWritesTheExrInstead) {
+    std::string d = temp_dir("png-fail");
+    RunResult r = run_candela("--width 24 --height 16 --frames 2 --out " + d + "/x.png");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string earlier = read_bytes(d + "/x.png");
+    r = run_candela("--width 24 --height 16 --frames 2 --out " + d + "/x.png", "CANDELA_TEST_FAIL_GL=1");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(d + "/x.png: OSMesa: cannot create an OpenGL context"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(d + "/x.png not written; the image is in " + d + "/x.exr (linear EXR) instead"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("2 spp in "), std::string::npos) << r.output;
+    EXPECT_EQ(read_bytes(d + "/x.png"), earlier);  // untouched
+    Image img = read_linear_image(d + "/x.exr");
+    EXPECT_EQ(img.width, 24);
+    EXPECT_EQ(img.height, 16);
+    double sum = 0;
+    for (float v : img.rgb) sum += v;
+    EXPECT_GT(sum, 0.0);
+}

@@ -228,8 +228,23 @@ int run_headless(const HeadlessOptions& opt) {
     if (checkpointing && whole_passes) save("final");
 
     Image img{film.width(), film.height(), film.resolve()};
-    if (ext == ".png") write_png_headless(opt.out, img, opt.display);
-    else write_linear_image(opt.out, img);
+    std::string written = opt.out;
+    bool png_failed = false;
+    if (ext == ".png") {
+        // The PNG goes through GL; if that fails the samples must not go with it.
+        try {
+            write_png_headless(opt.out, img, opt.display);
+        } catch (const std::exception& e) {
+            png_failed = true;
+            written = std::filesystem::path(opt.out).replace_extension(".exr").string();
+            std::fprintf(stderr, "candela: %s\n", e.what());
+            write_linear_image(written, img);
+            std::fprintf(stderr, "candela: %s not written; the image is in %s (linear EXR) instead\n",
+                         opt.out.c_str(), written.c_str());
+        }
+    } else {
+        write_linear_image(opt.out, img);
+    }
 
     const int sig = g_signal.load();
     if (!opt.quiet) {
@@ -248,13 +263,14 @@ int run_headless(const HeadlessOptions& opt) {
                      scene.source.c_str(), film.width(),
                      film.height(), spp, secs, secs > 0 ? samples / secs * 1e-6 : 0.0,
                      secs > 0 ? rays / secs * 1e-6 : 0.0, threads, scene.accel->name().c_str(),
-                     (unsigned long long)film.nonfinite_count(), opt.out.c_str());
+                     (unsigned long long)film.nonfinite_count(), written.c_str());
         if (checkpointing && whole_passes)
             std::fprintf(stderr, "candela: checkpoint %s at %u spp\n", opt.checkpoint.c_str(), spp_done);
         else if (checkpointing)
             std::fprintf(stderr, "candela: checkpoint %s not updated (stopped inside a pass; it keeps the last save)\n",
                          opt.checkpoint.c_str());
     }
+    if (png_failed) return 1;  // the file asked for is missing: a failure, even with the EXR beside it
     return sig ? 128 + sig : 0;
 }
 
