@@ -3,6 +3,8 @@
 // when GL fails; the viewer's fallback to headless when DISPLAY is unusable; scripts/run.sh.
 #include <gtest/gtest.h>
 #include <chrono>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <cstdlib>
 #include "film/image_io.h"
 #include "support/run.h"
@@ -101,4 +103,75 @@ TEST(PngOutput, GlFailureWritesTheExrInstead) {
     double sum = 0;
     for (float v : img.rgb) sum += v;
     EXPECT_GT(sum, 0.0);
+}
+
+namespace {
+bool file_exists_plain(const std::string& path) {
+    struct stat st;
+    return stat(path.c_str(), &st) == 0;
+}
+
+// Runs `command` with /bin/sh, stdout and stderr together.
+RunResult run_shell(const std::string& command) {
+    RunResult r;
+    FILE* p = popen((command + " 2>&1").c_str(), "r");
+    if (!p) return r;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+    int status = pclose(p);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return r;
+}
+
+// An X display number with no server behind it (no socket in /tmp/.X11-unix).
+int unused_display() {
+    for (int n = 87; n < 200; ++n)
+        if (!file_exists_plain("/tmp/.X11-unix/X" + std::to_string(n))) return n;
+    return -1;
+}
+}  // namespace
+
+// DISPLAY set but unusable, no --out: the viewer cannot start, candela says why and renders
+// headless to candela.png in the working directory, exit 0 (as with no DISPLAY at all).
+TEST(DisplayFallback, UnusableDisplayRendersHeadless) {
+    const int n = unused_display();
+    ASSERT_GT(n, 0);
+    // No server on a local socket; a refused TCP connection (port 6000 + n).
+    for (const std::string& display : {":" + std::to_string(n), "127.0.0.1:" + std::to_string(n)}) {
+        std::string d = temp_dir("display-fallback");
+        RunResult r = run_shell("cd '" + d + "' && env -u WAYLAND_DISPLAY DISPLAY=" + display + " " + CANDELA_BIN +
+                                " --width 12 --height 8 --frames 1");
+        EXPECT_EQ(r.exit_code, 0) << display << ": " << r.output;
+        EXPECT_NE(r.output.find("candela: cannot use the display (viewer: cannot initialise GLFW"), std::string::npos)
+            << r.output;
+        EXPECT_NE(r.output.find("; rendering headless to candela.png"), std::string::npos) << r.output;
+        EXPECT_GT(read_bytes(d + "/candela.png").size(), 50u) << r.output;
+    }
+}
+
+// scripts/run.sh, with stubs for setup.sh, build.sh and the program (which prints its arguments).
+TEST(RunScript, AddsOutOnlyWhenThereIsNone) {
+    std::string d = temp_dir("run-sh");
+    ASSERT_EQ(std::system(("mkdir -p '" + d + "/scripts' '" + d + "/build/bin' && cp '" CANDELA_SOURCE_DIR
+                           "/scripts/run.sh' '" + d + "/scripts/'").c_str()),
+              0);
+    write_text(d + "/scripts/setup.sh", "exit 0\n");
+    write_text(d + "/scripts/build.sh", "exit 0\n");
+    write_text(d + "/build/bin/candela", "#!/bin/sh\nfor a in \"$@\"; do echo \"arg[$a]\"; done\n");
+    ASSERT_EQ(std::system(("chmod +x '" + d + "/build/bin/candela'").c_str()), 0);
+    auto run = [&](const std::string& env, const std::string& args) {
+        return run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " + env + " bash '" + d + "/scripts/run.sh' " + args);
+    };
+    RunResult r = run("", "s.xml --out x.exr");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output, "arg[s.xml]\narg[--out]\narg[x.exr]\n");
+    r = run("", "--out=x.exr --frames 4");
+    EXPECT_EQ(r.output, "arg[--out=x.exr]\narg[--frames]\narg[4]\n");
+    r = run("", "s.xml --frames 4");
+    EXPECT_EQ(r.output,
+              "run.sh: no display: rendering headless to out/candela.png\narg[s.xml]\narg[--frames]\narg[4]\narg[--"
+              "out]\narg[out/candela.png]\n");
+    r = run("DISPLAY=:0", "s.xml");
+    EXPECT_EQ(r.output, "arg[s.xml]\n");
 }

@@ -182,7 +182,7 @@ Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
     scene_ = scene;
 
     glfwSetErrorCallback(glfw_error);
-    if (!glfwInit()) throw Error("viewer: cannot initialise GLFW (no display?)");
+    if (!glfwInit()) throw DisplayUnavailable("viewer: cannot initialise GLFW (no display?)");
     open_window(params_.settings.width, params_.settings.height);
 
     SessionOptions so;
@@ -236,7 +236,7 @@ void Viewer::open_window(int image_w, int image_h) {
         }
     }
     window_ = glfwCreateWindow(w, h, "candela", nullptr, nullptr);
-    if (!window_) throw Error("viewer: cannot open a GL 3.3 core window");
+    if (!window_) throw DisplayUnavailable("viewer: cannot open a GL 3.3 core window");
     glfwMakeContextCurrent(window_);
     // Vsync paces the loop on a real display; the frame loop also paces itself (Xvfb has no vsync).
     glfwSwapInterval(opt_.benchmark || opt_.screenshot_after > 0 ? 0 : 1);
