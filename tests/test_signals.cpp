@@ -45,6 +45,14 @@ void write_big_obj(const std::string& path, int n) {
     std::fclose(f);
 }
 
+// A stop takes milliseconds on an idle machine; the bound leaves room for a loaded one (ctest -j2
+// beside the k-d tree tests) and for the sanitizer build.
+#ifdef CANDELA_SANITIZE
+constexpr double kMaxStopSeconds = 6.0;
+#else
+constexpr double kMaxStopSeconds = 1.5;
+#endif
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -136,7 +144,7 @@ TEST(Signals, SignalDuringLoadStopsAndKeepsTheOutput) {
         c.signal(sig);
         EXPECT_EQ(c.wait(60), 128 + sig);
         const double s = seconds_since(t);
-        EXPECT_LT(s, 1.0) << "the load went on after the signal";  // it takes several seconds
+        EXPECT_LT(s, kMaxStopSeconds) << "the load went on after the signal";  // it takes several seconds
         std::printf("signal %d: exit %.3f s after it\n", sig, s);
         std::string log = read_bytes(d + "/log");
         EXPECT_NE(log.find(std::string(sig == SIGINT ? "interrupted" : "terminated") +

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include "app/checkpoint.h"
 #include "core/error.h"

@@ -29,10 +29,19 @@ std::string read_text_file(const std::string& path) {
     if (std::filesystem::is_directory(path, ec)) throw Error(path, 0, "is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
+    // In chunks, so that an interrupt is noticed while a big file is read.
+    std::string text;
+    const size_t chunk = size_t(1) << 22;
+    for (;;) {
+        throw_if_interrupted();
+        const size_t have = text.size();
+        text.resize(have + chunk);
+        in.read(&text[have], std::streamsize(chunk));
+        text.resize(have + size_t(in.gcount()));
+        if (size_t(in.gcount()) < chunk) break;
+    }
     if (in.bad()) throw Error(path, 0, "cannot read file");
-    return ss.str();
+    return text;
 }
 
 std::string directory_of(const std::string& path) {
