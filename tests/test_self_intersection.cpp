@@ -23,6 +23,7 @@
 #include "sampling/warp.h"
 #include "scene/obj.h"
 #include "scene/scene.h"
+#include "support/shared_assets.h"
 
 using namespace candela;
 
@@ -197,8 +198,8 @@ TEST(SelfIntersection, RandomTrianglesNeverHitThemselves) {
 // The same property on a real mesh, through the whole scene as well: the closest hit of a spawned
 // ray is never its own triangle (neighbours sharing an edge may legitimately be hit).
 TEST(SelfIntersection, BunnyNeverHitsItself) {
-    const std::string path = std::string(CANDELA_SHARED_DIR) + "/assets/meshes/bunny.obj";
-    if (!std::ifstream(path)) GTEST_SKIP() << path << " is absent";
+    const std::string path = candela::test::shared_mesh_path("bunny.obj");
+    CANDELA_REQUIRE_SHARED_MESH(path);
     ObjData obj = read_obj(path, false);
     std::vector<uvec3> tris;
     for (const ObjGroup& g : obj.groups) tris.insert(tris.end(), g.triangles.begin(), g.triangles.end());
