@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
@@ -409,6 +410,10 @@ void XmlLoader::load_film(pugi::xml_node n) {
         finish(f);
         c.used = have_filter = true;
     }
+    if (!have_filter)  // no filters yet; many scenes omit rfilter, so this is not an error
+        scene_.warnings.push_back(path_ + ":" + std::to_string(line(n)) +
+                                  ": film without <rfilter>: candela renders with a box filter, where Mitsuba 3 "
+                                  "would use its default gaussian");
     finish(o);
 }
 
@@ -814,6 +819,7 @@ SceneDescription XmlLoader::load() {
 
     pugi::xml_node sensor, integrator;
     for (pugi::xml_node c : root.children()) {
+        throw_if_interrupted();  // a scene of many shapes; each OBJ polls as it is read
         if (c.type() != pugi::node_element) continue;
         std::string tag = c.name();
         if (tag == "default") {
