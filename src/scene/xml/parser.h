@@ -15,7 +15,9 @@
 #include <pugixml.hpp>
 #include <initializer_list>
 #include <map>
+#include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 #include "core/error.h"
 #include "scene/loaders.h"
@@ -67,8 +69,10 @@ public:
     const std::string& file_of(pugi::xml_node n) const;           // the file a node was read from
     int line(pugi::xml_node n) const;
     Error error(pugi::xml_node n, const std::string& what) const { return Error(file_of(n), line(n), what); }
-    // A file named by the scene (mesh, texture), resolved against the directory of the file that
-    // names it.
+    // A file named by the scene (mesh, texture, spectrum) as Mitsuba's file resolver finds it: an
+    // absolute path as is; else the first that exists of the <path> folders (latest first), the
+    // main scene's folder and the folder of the file that names it (`from`'s document). When none
+    // exists, the main folder's candidate (for the error message).
     std::string resolve(pugi::xml_node from, const std::string& file) const;
 
     // ---- reading elements ----
@@ -99,9 +103,15 @@ public:
         pugi::xml_node node;
         int material = -1;  // bsdfs: the material once created
     };
-    void register_id(pugi::xml_node n, const std::string& tag);
-    // The element with this id, checked to be a <tag>; errors name the referencing node.
+    // Every element with an id, in any file and at any depth, is known before the first object is
+    // built, so a <ref> may precede its definition (Mitsuba resolves references after parsing).
+    // The element with this id (aliases followed), checked to be a <tag> (any tag when empty);
+    // errors (unknown id, another kind) name the referencing node. Families use it for refs to
+    // their objects: textures, emitters, shapes.
     IdEntry& object_by_id(pugi::xml_node ref_node, const std::string& id, const std::string& tag);
+    // The element a nested object stands for: itself, or the definition a <ref> names (checked
+    // to be a <tag>).
+    pugi::xml_node definition(const Nested& c, const std::string& tag);
     int shape_counter = 0;  // shapes read so far (for default names)
 
     // ---- bsdfs, shared by the shape and bsdf families ----
@@ -114,21 +124,55 @@ public:
     Material nested_bsdf(Object& wrapper);
 
 private:
-    int line_of_offset(ptrdiff_t offset) const;
+    // One parsed file: the main scene or an included one. Nodes of every document stay valid
+    // until the loader is destroyed, so elements of included files are read like the main file's.
+    struct Document {
+        std::string path, dir;                 // dir ends with '/' (or is empty)
+        std::vector<size_t> line_starts;       // byte offsets where lines 2, 3, ... begin
+        pugi::xml_document doc;
+        std::string version;                   // the root's version attribute, as written
+        bool upgraded = false;                 // read with Mitsuba 3's upgrade rules (< 2.0.0)
+    };
+    const Document& doc_of(pugi::xml_node n) const;
+    Document& parse_document(const std::string& path, pugi::xml_node included_from);
+    // The pass over the document tree in Mitsuba's order (depth first, includes in place): $name
+    // substitution, <default>, <path>, <include>, version upgrades and ids. Fills children_.
+    void expand(pugi::xml_node parent, bool scene_level, std::vector<pugi::xml_node>& out, int depth);
+    void register_id(pugi::xml_node n, const std::string& tag);
+    void substitute_attributes(pugi::xml_node n);
+    void substitute_tree(pugi::xml_node n);
     std::string substitute(pugi::xml_node n, const std::string& text) const;
-    std::vector<float> numbers(pugi::xml_node n, const char* name, std::initializer_list<size_t> counts) const;
-    Param read_property(pugi::xml_node n) const;
-    mat4 read_transform(pugi::xml_node n) const;
+    void check_version(pugi::xml_node root, Document& d, bool required);
     void load_default(pugi::xml_node n);
+    void load_path(pugi::xml_node n);
+    void load_include(pugi::xml_node n, bool scene_level, std::vector<pugi::xml_node>& out, int depth);
+    std::string find_include(pugi::xml_node from, const std::string& file) const;
 
-    std::string path_, dir_;
-    std::vector<size_t> line_starts_;  // byte offsets where lines 2, 3, ... begin
-    std::map<std::string, std::string> vars_;
+    std::vector<float> numbers(pugi::xml_node n, const char* name, std::initializer_list<size_t> counts) const;
+    Param read_property(pugi::xml_node n, bool within_emitter) const;
+    Param read_spectrum(pugi::xml_node n, bool within_emitter) const;
+    mat4 read_transform(pugi::xml_node n) const;
+    const std::vector<pugi::xml_node>& children(pugi::xml_node n) const;  // includes expanded
+    uint32_t bsdf_element(pugi::xml_node n, const std::string& fallback_name);
+
+    std::string path_;
+    std::vector<std::unique_ptr<Document>> docs_;
+    std::unordered_map<const void*, const Document*> doc_by_root_;  // pugi document node -> Document
+    // Element children of every object element and of <scene>, with includes spliced in and
+    // <default>/<path>/<include> consumed, in document order.
+    std::unordered_map<const void*, std::vector<pugi::xml_node>> children_;
+    std::vector<std::string> include_stack_;  // canonical paths of the files being expanded
+    std::vector<std::string> search_path_;    // <path> folders, latest first (Mitsuba prepends)
+    std::vector<std::pair<std::string, std::string>> vars_;  // $name values, -D first
     std::map<std::string, IdEntry> ids_;
+    std::map<std::string, std::string> aliases_;  // <alias id as>: as -> id
     // The bsdfs being built, outermost first: wrappers (twosided) recurse through nested bsdfs and
     // refs, so a ref cycle or a deep nest must be an error before it is a stack overflow.
     std::vector<pugi::xml_node> bsdf_stack_;
     static constexpr size_t kMaxBsdfNesting = 64;
+    static constexpr int kMaxIncludeDepth = 15;
+    static constexpr int kMaxObjectNesting = 256;
+    int bsdf_nesting_ = 0, object_nesting_ = 0;  // while expand() is inside nested objects  // Mitsuba's MI_XML_INCLUDE_MAX_RECURSION
     SceneDescription scene_;
 };
 

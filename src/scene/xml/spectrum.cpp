@@ -113,7 +113,38 @@ const float kCie1931[kCieSamples][3] = {
     {1.251141e-06f, 4.5181e-07f, 0.f},  // 830 nm
 };
 
+// The CIE standard illuminant D65, 5 nm steps from 360 nm (published CIE data), and Mitsuba's
+// scale that makes ∫ D65 ȳ over the table equal ∫ ȳ (MI_CIE_D65_NORMALIZATION).
+const float kD65[kCieSamples] = {
+    46.6383f, 49.3637f, 52.0891f, 51.0323f, 49.9755f, 52.3118f, 54.6482f, 68.7015f,
+    82.7549f, 87.1204f, 91.486f, 92.4589f, 93.4318f, 90.057f, 86.6823f, 95.7736f,
+    104.865f, 110.936f, 117.008f, 117.41f, 117.812f, 116.336f, 114.861f, 115.392f,
+    115.923f, 112.367f, 108.811f, 109.082f, 109.354f, 108.578f, 107.802f, 106.296f,
+    104.79f, 106.239f, 107.689f, 106.047f, 104.405f, 104.225f, 104.046f, 102.023f,
+    100.f, 98.1671f, 96.3342f, 96.0611f, 95.788f, 92.2368f, 88.6856f, 89.3459f,
+    90.0062f, 89.8026f, 89.5991f, 88.6489f, 87.6987f, 85.4936f, 83.2886f, 83.4939f,
+    83.6992f, 81.863f, 80.0268f, 80.1207f, 80.2146f, 81.2462f, 82.2778f, 80.281f,
+    78.2842f, 74.0027f, 69.7213f, 70.6652f, 71.6091f, 72.979f, 74.349f, 67.9765f,
+    61.604f, 65.7448f, 69.8856f, 72.4863f, 75.087f, 69.3398f, 63.5927f, 55.0054f,
+    46.4182f, 56.6118f, 66.8054f, 65.0941f, 63.3828f, 63.8434f, 64.304f, 61.8779f,
+    59.4519f, 55.7054f, 51.959f, 54.6998f, 57.4406f, 58.8765f, 60.3125f,
+};
+constexpr double kD65Normalization = 0.010101273599490354;
+
 }  // namespace
+
+double cie_d65(double lambda) {
+    if (!(lambda >= kCieMin && lambda <= kCieMax)) return 0.0;
+    double t = (lambda - kCieMin) * ((kCieSamples - 1) / (kCieMax - kCieMin));
+    int i0 = std::min(std::max(int(t), 0), kCieSamples - 2);
+    float w1 = float(t - i0), w0 = 1.f - w1;
+    return double(w0 * kD65[i0] + w1 * kD65[i0 + 1]) * kD65Normalization;
+}
+
+vec3 xyz_to_linear_srgb(double x, double y, double z) {
+    return vec3(float(3.240479 * x - 1.537150 * y - 0.498535 * z), float(-0.969256 * x + 1.875991 * y + 0.041556 * z),
+                float(0.055648 * x - 0.204043 * y + 1.057311 * z));
+}
 
 vec3 cie1931_xyz(double lambda) {
     if (!(lambda >= kCieMin && lambda <= kCieMax)) return vec3(0.f);
@@ -125,7 +156,7 @@ vec3 cie1931_xyz(double lambda) {
     return vec3(w0 * a[0] + w1 * b[0], w0 * a[1] + w1 * b[1], w0 * a[2] + w1 * b[2]);
 }
 
-vec3 spectrum_list_to_srgb(const std::vector<double>& wl, const std::vector<double>& values, bool bounded) {
+vec3 spectrum_list_to_srgb(const std::vector<double>& wl, const std::vector<double>& values, bool bounded, bool d65) {
     const int steps = 1000;
     double x = 0, y = 0, z = 0;
     size_t n = wl.size();
@@ -136,19 +167,18 @@ vec3 spectrum_list_to_srgb(const std::vector<double>& wl, const std::vector<doub
         size_t k = size_t(std::upper_bound(wl.begin(), wl.end(), w) - wl.begin());
         k = std::min(std::max(k, size_t(1)) - 1, n - 2);
         double w0 = wl[k], w1 = wl[k + 1];
-        double v0 = values[k] * kCieYNormalization, v1 = values[k + 1] * kCieYNormalization;
-        double v = ((w - w1) * v0 + (w0 - w) * v1) / (w0 - w1);
+        double v = ((w - w1) * values[k] + (w0 - w) * values[k + 1]) / (w0 - w1);
+        if (d65) v *= cie_d65(w);
         vec3 c = cie1931_xyz(w);
         x += c.x * v;
         y += c.y * v;
         z += c.z * v;
     }
-    double scale = (kCieMax - kCieMin) / steps;
+    double scale = (kCieMax - kCieMin) / steps * kCieYNormalization;
     x *= scale;
     y *= scale;
     z *= scale;
-    vec3 rgb(float(3.240479 * x - 1.537150 * y - 0.498535 * z), float(-0.969256 * x + 1.875991 * y + 0.041556 * z),
-             float(0.055648 * x - 0.204043 * y + 1.057311 * z));
+    vec3 rgb = xyz_to_linear_srgb(x, y, z);
     for (int c = 0; c < 3; ++c) rgb[c] = bounded ? std::min(std::max(rgb[c], 0.f), 1.f) : std::max(rgb[c], 0.f);
     return rgb;
 }

@@ -11,15 +11,24 @@ namespace xml {
 // published 5 nm samples over [360, 830] nm; zero outside.
 vec3 cie1931_xyz(double lambda_nm);
 
+// The CIE D65 illuminant, linearly interpolated between its 5 nm samples, scaled by Mitsuba's
+// MI_CIE_D65_NORMALIZATION (so that a unit reflectance under it integrates to Y = 1); zero outside
+// [360, 830] nm.
+double cie_d65(double lambda_nm);
+
+// CIE XYZ -> linear sRGB (D65 white), Mitsuba's xyz_to_srgb matrix.
+vec3 xyz_to_linear_srgb(double x, double y, double z);
+
 // A piecewise-linear spectrum (wavelengths in nm, strictly increasing, at least two) as linear
-// sRGB, as Mitsuba's RGB variants convert a wavelength:value list:
-//   values are scaled by 1 / ∫ȳ (MI_CIE_Y_NORMALIZATION) and integrated against the matching
-//   functions with 1000 uniform steps over [360, 830] nm (the spectrum is zero outside its own
-//   range), then XYZ -> linear sRGB (D65 white). No illuminant is multiplied in, for reflectances
-//   and emitters alike: a constant spectrum of 1 gives (1, 1, 1) up to the table's rounding.
-//   bounded (reflectances): the result is clamped to [0, 1]; unbounded (emitters, eta, k, int_ior,
-//   ext_ior): negative components are clamped to 0.
-vec3 spectrum_list_to_srgb(const std::vector<double>& wavelengths, const std::vector<double>& values, bool bounded);
+// sRGB, as Mitsuba 3.9's RGB variants convert a wavelength:value list (spectrum_list_to_srgb):
+//   XYZ = MI_CIE_Y_NORMALIZATION * Σ_i xyz̄(λ_i) s(λ_i) [D65(λ_i)] Δλ, 1000 uniform steps λ_i over
+//   [360, 830] nm, Δλ = 470/1000 nm, s = 0 outside its own range; then XYZ -> linear sRGB.
+//   d65: multiply by the normalised D65 illuminant. Mitsuba does so for every spectrum that is not
+//   an emitter's (reflectances, eta, k...), so that a flat reflectance of 1 is white (1, 1, 1),
+//   and not for emitters (a flat emission spectrum is then the purple-ish xyz_to_srgb(1, 1, 1)).
+//   bounded (reflectances): clamped to [0, 1]; otherwise negative components are clamped to 0.
+vec3 spectrum_list_to_srgb(const std::vector<double>& wavelengths, const std::vector<double>& values, bool bounded,
+                           bool d65);
 
 }  // namespace xml
 }  // namespace candela
