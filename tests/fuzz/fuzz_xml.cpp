@@ -9,8 +9,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string path = candela::fuzz::write_input("scene.xml", data, size);
     try {
-        candela::Scene scene = candela::load_mitsuba_xml(path, {});
-        scene.finalize();
+        candela::build_scene(candela::load_mitsuba_xml(path, {}));
     } catch (const candela::Error&) {
         // the expected outcome for bad input
     }

@@ -147,6 +147,8 @@ const XmlLoader::Document& XmlLoader::doc_of(pugi::xml_node n) const {
 const std::string& XmlLoader::file_of(pugi::xml_node n) const { return docs_.empty() ? path_ : doc_of(n).path; }
 
 int XmlLoader::line(pugi::xml_node n) const {
+    // Elements made by the version upgrade have no offset: they take their parent's line.
+    while (n && n.offset_debug() < 0 && n.parent()) n = n.parent();
     ptrdiff_t offset = n.offset_debug();
     if (offset < 0 || docs_.empty()) return 0;
     const std::vector<size_t>& starts = doc_of(n).line_starts;
