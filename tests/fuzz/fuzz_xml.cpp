@@ -1,4 +1,4 @@
-// libFuzzer target: the Mitsuba XML scene loader, then finalize (geometry checks, accelerator and
+// libFuzzer target: the Mitsuba XML scene loader, then build_scene (geometry checks, accelerator and
 // lights), as the program does before rendering. Any input must load or throw candela::Error; a
 // crash, a sanitizer report, another exception, a leak or a hang is a finding.
 #include <cstdint>

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include "core/interrupt.h"
 #include "scene/obj.h"
 #include "scene/xml/plugins.h"
 #include "scene/xml/spectrum.h"
@@ -818,6 +819,7 @@ SceneDescription XmlLoader::load() {
 
         pugi::xml_node sensor, integrator;
         for (pugi::xml_node c : top) {
+            throw_if_interrupted();  // a scene of many shapes; each OBJ polls as it is read
             std::string tag = c.name();
             if (tag == "integrator") {
                 if (integrator) throw error(c, "more than one <integrator> (first at line " + std::to_string(line(integrator)) + ")");
