@@ -11,6 +11,7 @@
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
+#include "scene/shapes_analytic.h"
 
 namespace candela {
 
@@ -753,11 +754,14 @@ void XmlLoader::load_shape(pugi::xml_node n) {
     ShapeFactory make = nullptr;
     for (const auto& p : kShapePlugins)
         if (o.type == p.first) make = p.second;
-    if (!make) throw error(n, "unsupported shape type '" + o.type + "' (candela supports: obj, rectangle, cube)");
+    const bool analytic = is_analytic_shape_type(o.type);
+    if (!make && !analytic)
+        throw error(n, "unsupported shape type '" + o.type + "' (candela supports: obj, rectangle, cube, sphere, disk, cylinder)");
     ++shape_counter_;
     mat4 m = o.params.get_transform("to_world", mat4(1.f));
     bool flip = o.params.get_bool("flip_normals", false);
-    ShapeGeometry g = make(*this, o);
+    ShapeGeometry g = make ? make(*this, o) : ShapeGeometry{};
+    AnalyticShape a = analytic ? make_analytic_shape(o.type, o.params, o.line, m, flip) : AnalyticShape{};
     uint32_t material = material_for(o);
 
     int32_t emitter = -1;
@@ -774,6 +778,11 @@ void XmlLoader::load_shape(pugi::xml_node n) {
         c.used = true;
     }
     finish(o);
+    if (analytic) {
+        scene_.add_analytic_shape(n.attribute("id") ? attr(n, "id") : o.type + std::to_string(shape_counter_), a, material,
+                                  emitter);
+        return;
+    }
 
     // To world space: points by M, normals by the inverse transpose.
     glm::mat3 lin(m);

@@ -646,6 +646,9 @@ void Viewer::panel_pick() {
     }
     const Shape& shape = scene_->shapes[pick_.shape];
     ImGui::Text("object  %s", shape.name.c_str());
+    static const char* const kKinds[] = {"triangle", "sphere", "disk", "cylinder"};
+    if (pick_.kind == PrimKind::Triangle) ImGui::Text("triangle  %u", pick_.triangle);
+    else ImGui::Text("%s  uv %.4f %.4f", kKinds[int(pick_.kind)], pick_.uv.x, pick_.uv.y);
     if (pick_.material < params_.materials.size()) {
         const Material& m = params_.materials[pick_.material];
         ImGui::Text("material  %s (%s)", m.name.c_str(), bsdf_type_name(m.bsdf));
