@@ -603,9 +603,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         // holds the origin, so the next node is always the child on the origin's side (the exact
         // test of the general step below), and the other child is pushed when the ray reaches the
         // plane inside the segment. The general step visits the same nodes with the same
-        // intervals, but its branches on tp mispredict here: masks instead of branches make the
-        // walk from the root to a surface point (half of a bounce or shadow ray's node visits)
-        // ~10-20% faster (docs/accel.md).
+        // intervals, but its branches on tp mispredict here, so this walk (half of a bounce or
+        // shadow ray's node visits) uses masks instead (docs/accel.md has the measurements).
         const __m128 zero = _mm_setzero_ps(), up = _mm_set_ss(kWidenUp), down = _mm_set_ss(kWidenDown);
         const __m128 inf = _mm_set_ss(kInfinity);
         while (!node->leaf()) {
@@ -648,8 +647,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
             // for a ray lying in the plane, which then visits both children over the whole interval
             // (std::max / std::min return their first argument for a NaN second). Branches, not
-            // selects: a branch-free step measured 9% slower on bounce rays and much slower on
-            // (well predicted) primary rays (docs/accel.md).
+            // selects: they predict well here, and a branch-free step makes every step wait for
+            // its comparisons (docs/accel.md has the measurements).
             // An empty child is never entered nor stacked: the walk goes on with the other one
             // (its interval trimmed as if the empty one had been visited), or with the stack.
             const uint32_t first_empty = node->empty_child(!below_first), second_empty = node->empty_child(below_first);

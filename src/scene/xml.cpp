@@ -419,6 +419,10 @@ void XmlLoader::load_film(pugi::xml_node n) {
         finish(f);
         c.used = have_filter = true;
     }
+    if (!have_filter)  // no filters yet; many scenes omit rfilter, so this is not an error
+        scene_.warnings.push_back(path_ + ":" + std::to_string(line(n)) +
+                                  ": film without <rfilter>: candela renders with a box filter, where Mitsuba 3 "
+                                  "would use its default gaussian");
     finish(o);
     scene_.settings.width = w;
     scene_.settings.height = h;

@@ -106,9 +106,10 @@ void Viewer::open_window(int image_w, int image_h) {
     gl_ = load_gl_api(reinterpret_cast<GlGetProcAddress>(glfwGetProcAddress));
     program_ = std::make_unique<DisplayProgram>(gl_);
     {
-        // A software GL compiles each pipeline variant on first use (60 ms measured with llvmpipe,
-        // whose samplers are specialised on power-of-two texture sizes): run the preview's scaling
-        // blit now from a power-of-two and from another source, so that no camera change pays.
+        // A software GL compiles each pipeline variant on first use (llvmpipe specialises its
+        // samplers on power-of-two texture sizes; docs/viewer.md has the cost): run the preview's
+        // scaling blit now from a power-of-two and from another source, so that no camera change
+        // pays for it.
         unsigned fbo = 0, tex = 0;
         int cw = 0, ch = 0;
         ensure_color_target(gl_, fbo, tex, cw, ch, 8, 8);
