@@ -54,9 +54,11 @@ struct SceneDescription {
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
 
-    // Appends a shape made of the given triangles (world space). Returns its index.
+    // Appends a shape made of the given triangles (world space). Returns its index. `uvs` and
+    // `colors` are per vertex or empty (then the mesh stores none for this shape).
     uint32_t add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
-                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter);
+                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter,
+                       const std::vector<vec2>& uvs = {}, const std::vector<vec3>& colors = {});
 };
 
 // The immutable triangle geometry, shared by every Scene built from one description.
