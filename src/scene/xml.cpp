@@ -11,6 +11,7 @@
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
+#include "shapes/mesh_file.h"
 
 namespace candela {
 
@@ -64,6 +65,8 @@ using BsdfFactory = Material (*)(XmlLoader&, Object&);
 struct ShapeGeometry {
     std::vector<vec3> positions, normals;  // object space; normals empty or per vertex
     std::vector<uvec3> triangles;
+    std::vector<vec2> uvs;     // per vertex or empty; unchanged by to_world
+    std::vector<vec3> colors;  // per vertex or empty
     // Mitsuba's rectangle and cube: under a mirroring to_world their geometric normal follows the
     // transformed winding but their shading normal is to_world^-T n_local, so the two disagree
     // (Mitsuba 3.9 checked). `normals` then become vertex normals, and are dropped otherwise.
@@ -84,6 +87,8 @@ Material make_twosided(XmlLoader& L, Object& o);
 ShapeGeometry make_obj(XmlLoader& L, Object& o);
 ShapeGeometry make_rectangle(XmlLoader& L, Object& o);
 ShapeGeometry make_cube(XmlLoader& L, Object& o);
+ShapeGeometry make_ply(XmlLoader& L, Object& o);
+ShapeGeometry make_serialized(XmlLoader& L, Object& o);
 
 // The extension points: one factory per plugin type. A new BSDF (conductor, plastic, twosided...)
 // is one function plus one row here; its type then disappears from kPlannedBsdfs.
@@ -101,6 +106,8 @@ const std::pair<const char*, ShapeFactory> kShapePlugins[] = {
     {"obj", make_obj},
     {"rectangle", make_rectangle},
     {"cube", make_cube},
+    {"ply", make_ply},
+    {"serialized", make_serialized},
 };
 
 class XmlLoader {
@@ -696,7 +703,7 @@ ShapeGeometry make_obj(XmlLoader& L, Object& o) {
     if (!o.params.has("filename")) throw L.error(o.node, "shape 'obj' needs a 'filename' string");
     std::string file = o.params.get_string("filename", "");
     bool face_normals = o.params.get_bool("face_normals", false);
-    o.params.get_bool("flip_tex_coords", true);  // candela reads no texture coordinates
+    bool flip_tex = o.params.get_bool("flip_tex_coords", true);
     std::string full = L.resolve(file);
     if (!std::ifstream(full)) throw o.params.error("filename", "cannot open OBJ file '" + file + "' (" + full + ")");
     ObjData obj;
@@ -712,39 +719,98 @@ ShapeGeometry make_obj(XmlLoader& L, Object& o) {
         if (obj.all_have_normals()) g.normals = obj.normals;
         else g.recompute_normals = true;
     }
+    if (obj.all_have_uvs()) g.uvs = obj.uvs;
+    if (flip_tex)
+        for (vec2& uv : g.uvs) uv.y = 1.f - uv.y;
     return g;
 }
 
-ShapeGeometry make_rectangle(XmlLoader&, Object&) {
+// ply and serialized: the file's data, with Mitsuba's mesh flags.
+ShapeGeometry mesh_file_geometry(MeshFile f, bool face_normals, bool flip_tex) {
+    ShapeGeometry g;
+    g.positions = std::move(f.positions);
+    g.triangles = std::move(f.triangles);
+    g.uvs = std::move(f.uvs);
+    g.colors = std::move(f.colors);
+    if (!face_normals) {
+        if (!f.normals.empty()) g.normals = std::move(f.normals);
+        else g.recompute_normals = true;
+    }
+    if (flip_tex)
+        for (vec2& uv : g.uvs) uv.y = 1.f - uv.y;
+    return g;
+}
+
+std::string mesh_file_path(XmlLoader& L, Object& o, const char* what) {
+    if (!o.params.has("filename")) throw L.error(o.node, o.what() + " needs a 'filename' string");
+    std::string file = o.params.get_string("filename", "");
+    std::string full = L.resolve(file);
+    if (!std::ifstream(full)) throw o.params.error("filename", std::string("cannot open ") + what + " file '" + file + "' (" + full + ")");
+    return full;
+}
+
+ShapeGeometry make_ply(XmlLoader& L, Object& o) {
+    std::string full = mesh_file_path(L, o, "PLY");
+    bool face_normals = o.params.get_bool("face_normals", false);
+    bool flip_tex = o.params.get_bool("flip_tex_coords", false);  // Mitsuba's ply default, unlike obj
+    try {
+        return mesh_file_geometry(read_ply(full), face_normals, flip_tex);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
+    }
+}
+
+ShapeGeometry make_serialized(XmlLoader& L, Object& o) {
+    std::string full = mesh_file_path(L, o, "serialized");
+    bool face_normals = o.params.get_bool("face_normals", false);
+    int index = o.params.get_int("shape_index", 0);
+    if (index < 0) throw o.params.error("shape_index", "shape_index must be >= 0");
+    MeshFile f;
+    try {
+        f = read_serialized(full, index);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
+    }
+    // Mitsuba 3.9 reads past a serialized mesh's colours and ignores its face-normals flag
+    // (checked against 3.9.1): candela does the same, so both render the same image.
+    f.colors.clear();
+    return mesh_file_geometry(std::move(f), face_normals, false);
+}
+
+ShapeGeometry make_rectangle(XmlLoader&, Object& o) {
+    o.params.get_bool("face_normals", false);  // Mitsuba's rectangle is flat either way
     ShapeGeometry g;
     g.analytic = true;
     g.positions = {vec3(-1.f, -1.f, 0.f), vec3(1.f, -1.f, 0.f), vec3(1.f, 1.f, 0.f), vec3(-1.f, 1.f, 0.f)};
+    g.uvs = {vec2(0.f, 0.f), vec2(1.f, 0.f), vec2(1.f, 1.f), vec2(0.f, 1.f)};  // Mitsuba: uv = (p.xy + 1) / 2
     g.normals.assign(4, vec3(0.f, 0.f, 1.f));
     g.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};  // counter-clockwise seen from +z: normal +z
     return g;
 }
 
-ShapeGeometry make_cube(XmlLoader&, Object&) {
+ShapeGeometry make_cube(XmlLoader&, Object& o) {
+    bool face_normals = o.params.get_bool("face_normals", false);
     ShapeGeometry g;
-    g.analytic = true;
-    // Four corners per face (no shared vertices), wound so that every normal points outwards.
-    for (int axis = 0; axis < 3; ++axis)
-        for (int s = -1; s <= 1; s += 2) {
-            vec3 n(0.f);
-            n[axis] = float(s);
-            vec3 u(0.f), v(0.f);
-            u[(axis + 1) % 3] = 1.f;
-            v[(axis + 2) % 3] = 1.f;
-            if (s < 0) std::swap(u, v);  // keeps cross(u, v) == n
-            uint32_t b = uint32_t(g.positions.size());
-            g.positions.push_back(n - u - v);
-            g.positions.push_back(n + u - v);
-            g.positions.push_back(n + u + v);
-            g.positions.push_back(n - u + v);
-            g.normals.insert(g.normals.end(), 4, n);
-            g.triangles.push_back(uvec3(b, b + 1, b + 2));
-            g.triangles.push_back(uvec3(b, b + 2, b + 3));
+    g.analytic = !face_normals;  // Mitsuba's cube is a mesh: face_normals drops its vertex normals
+    // Mitsuba 3's cube (src/shapes/cube.cpp): four corners per face, in its order, with its uvs,
+    // wound so that every normal points outwards.
+    static const float kPos[24][3] = {
+        {1, -1, -1}, {1, -1, 1},  {-1, -1, 1}, {-1, -1, -1}, {1, 1, -1},  {-1, 1, -1}, {-1, 1, 1},  {1, 1, 1},
+        {1, -1, -1}, {1, 1, -1},  {1, 1, 1},   {1, -1, 1},   {1, -1, 1},  {1, 1, 1},   {-1, 1, 1},  {-1, -1, 1},
+        {-1, -1, 1}, {-1, 1, 1},  {-1, 1, -1}, {-1, -1, -1}, {1, 1, -1},  {1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}};
+    static const float kUv[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    for (int f = 0; f < 6; ++f) {
+        uint32_t b = uint32_t(4 * f);
+        for (int k = 0; k < 4; ++k) {
+            const float* p = kPos[4 * f + k];
+            g.positions.push_back(vec3(p[0], p[1], p[2]));
+            g.uvs.push_back(vec2(kUv[k][0], kUv[k][1]));
         }
+        g.triangles.push_back(uvec3(b, b + 1, b + 2));
+        g.triangles.push_back(uvec3(b + 3, b, b + 2));
+        vec3 n = glm::normalize(glm::cross(g.positions[b + 1] - g.positions[b], g.positions[b + 2] - g.positions[b]));
+        if (!face_normals) g.normals.insert(g.normals.end(), 4, n);
+    }
     return g;
 }
 
@@ -753,7 +819,11 @@ void XmlLoader::load_shape(pugi::xml_node n) {
     ShapeFactory make = nullptr;
     for (const auto& p : kShapePlugins)
         if (o.type == p.first) make = p.second;
-    if (!make) throw error(n, "unsupported shape type '" + o.type + "' (candela supports: obj, rectangle, cube)");
+    if (!make) {
+        std::string known;
+        for (const auto& p : kShapePlugins) known += (known.empty() ? "" : ", ") + std::string(p.first);
+        throw error(n, "unsupported shape type '" + o.type + "' (candela supports: " + known + ")");
+    }
     ++shape_counter_;
     mat4 m = o.params.get_transform("to_world", mat4(1.f));
     bool flip = o.params.get_bool("flip_normals", false);
@@ -795,9 +865,9 @@ void XmlLoader::load_shape(pugi::xml_node n) {
         for (vec3& nv : g.normals) nv = -nv;
     }
     std::string name = n.attribute("id") ? attr(n, "id")
-                       : o.type == "obj" ? o.params.get_string("filename", "obj")
+                       : o.params.has("filename") ? o.params.get_string("filename", o.type)
                                          : o.type + std::to_string(shape_counter_);
-    scene_.add_shape(name, g.positions, g.normals, g.triangles, material, emitter);
+    scene_.add_shape(name, g.positions, g.normals, g.triangles, material, emitter, g.uvs, g.colors);
 }
 
 SceneDescription XmlLoader::load() {
