@@ -5,7 +5,8 @@
 #   --sanitize  the ASan+UBSan build in build-asan/, every test (about 7x the Release suite's CPU
 #               time, see docs/reliability.md); CANDELA_ASAN_EXCLUDE=REGEX leaves tests out
 #               (ctest -E), e.g. '^(BsdfChi2|ImageCornell|KdTree)\.' for a quick local run
-#   --tsan      a ThreadSanitizer build in build-tsan/, the render session tests (Session.*), with
+#   --tsan      a ThreadSanitizer build in build-tsan/, the render session and the viewer's use of it
+#               without a window (Session.*, ViewerFrontEnd.*, SceneSplit.*), with
 #               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
 #               cannot see its barriers; one OpenMP thread per pass leaves TSan the session's own
 #               threads (worker and front end) to check. See docs/reliability.md.
@@ -41,7 +42,7 @@ case "$mode" in
     fi
     cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2
     export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp"
-    OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*'
+    OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*:ViewerFrontEnd.*:SceneSplit.*'
     ;;
   *) echo "test.sh: unknown option '$mode'" >&2; exit 2 ;;
 esac
