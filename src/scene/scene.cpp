@@ -191,6 +191,14 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
     return si;
 }
 
+vec3 Scene::vertex_color(const Hit& hit) const {
+    const Shape& shape = shapes[mesh.tri_shape[hit.prim]];
+    if (!shape.has_color()) return vec3(0.f);
+    const vec3* c = mesh.colors.data() + shape.color_offset - shape.first_vertex;
+    const uvec3& t = mesh.triangles[hit.prim];
+    return (1.f - hit.b1 - hit.b2) * c[t.x] + hit.b1 * c[t.y] + hit.b2 * c[t.z];
+}
+
 Scene::Memory Scene::memory() const {
     Memory m;
     m.triangles = mesh.triangles.size();

@@ -101,6 +101,10 @@ public:
 
     // Surface data at a hit, with the error bound of the point.
     SurfaceInteraction interaction(const Hit& hit) const;
+    // The vertex colours interpolated at a hit (Mitsuba's mesh attribute "vertex_color", what a
+    // mesh_attribute texture reads); zero on a shape without colours. Apart from interaction() so
+    // that only shading that reads colours pays for them.
+    vec3 vertex_color(const Hit& hit) const;
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.
