@@ -456,6 +456,9 @@ TEST(SerializedReader, BadInputIsOneClearError) {
     uint64_t far = 1ull << 40;
     std::memcpy(&bad[bad.size() - 4 - 8], &far, 8);
     expect(bad, 1, "mesh 1 starts at byte 1099511627776, beyond the file");
+    far = ~0ull - 1;  // found by fuzz_serialized: offset + 4 wrapped around to a small number
+    std::memcpy(&bad[bad.size() - 4 - 8], &far, 8);
+    expect(bad, 1, "mesh 1 starts at byte 18446744073709551614, beyond the file");
     bad = good;
     uint32_t many = 1u << 30;
     std::memcpy(&bad[bad.size() - 4], &many, 4);

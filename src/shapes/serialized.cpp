@@ -153,7 +153,7 @@ MeshFile parse_serialized(const std::string& name, const std::string& data, int 
         if (back > data.size()) throw at(data.size() - 4, "the dictionary of " + std::to_string(count) + " meshes is larger than the file");
         size_t pos = data.size() - size_t(back);
         uint64_t off = version == 4 ? load_le<uint64_t>(d + pos) : load_le<uint32_t>(d + pos);
-        if (off + 4 >= data.size())
+        if (off >= data.size() || data.size() - off <= 4)  // (not off + 4: it may wrap around)
             throw at(pos, "mesh " + std::to_string(shape_index) + " starts at byte " + std::to_string(off) + ", beyond the file");
         offset = size_t(off);
         if (load_le<uint16_t>(d + offset) != kMagic || load_le<uint16_t>(d + offset + 2) != version)
