@@ -522,3 +522,21 @@ TEST(SceneXml, EveryShippedSceneLoads) {
     EXPECT_FLOAT_EQ(alphas[0], 0.01f);
     EXPECT_FLOAT_EQ(alphas[3], 0.2f);
 }
+
+// Until candela has reconstruction filters, a film without <rfilter> (Mitsuba 3's gaussian) is
+// rendered with a box: the loader says so, naming the file and the film's line, and still loads.
+TEST(SceneXml, FilmWithoutRfilterWarnsOfTheBoxFilter) {
+    const std::string sensor_open = "<sensor type=\"perspective\">\n", sensor_close = "</sensor>\n";
+    const std::string path = write_temp("nofilter.xml", scene_xml(sensor_open + "<film type=\"hdrfilm\"/>\n" + sensor_close));
+    SceneDescription s = load_mitsuba_xml(path, {});
+    ASSERT_EQ(s.warnings.size(), 1u);
+    const std::string& w = s.warnings[0];
+    EXPECT_EQ(w.rfind(path + ":3: ", 0), 0u) << w;
+    EXPECT_NE(w.find("without <rfilter>"), std::string::npos) << w;
+    EXPECT_NE(w.find("box filter"), std::string::npos) << w;
+    EXPECT_NE(w.find("gaussian"), std::string::npos) << w;
+    // Control: with an explicit box filter there is nothing to warn about.
+    const std::string boxed = write_temp(
+        "box.xml", scene_xml(sensor_open + "<film type=\"hdrfilm\">\n<rfilter type=\"box\"/>\n</film>\n" + sensor_close));
+    EXPECT_TRUE(load_mitsuba_xml(boxed, {}).warnings.empty());
+}

@@ -32,10 +32,22 @@ void glfw_error(int code, const char* what) { std::fprintf(stderr, "candela: GLF
 double viewer_now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
-    std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
-
+    // The display first: without one the caller renders headless, and must not load the scene twice.
     glfwSetErrorCallback(glfw_error);
-    if (!glfwInit()) throw Error("viewer: cannot initialise GLFW (no display?)");
+    if (!glfwInit()) throw DisplayUnavailable("viewer: cannot initialise GLFW (no display?)");
+    try {
+        init();
+    } catch (...) {
+        // The destructor does not run for a constructor that throws.
+        if (window_) glfwDestroyWindow(window_);
+        glfwTerminate();
+        throw;
+    }
+}
+
+void Viewer::init() {
+    const ViewerOptions& opt = opt_;
+    std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
     open_window(scene->settings.width, scene->settings.height);
 
     SessionOptions so;
@@ -87,16 +99,17 @@ void Viewer::open_window(int image_w, int image_h) {
         }
     }
     window_ = glfwCreateWindow(w, h, "candela", nullptr, nullptr);
-    if (!window_) throw Error("viewer: cannot open a GL 3.3 core window");
+    if (!window_) throw DisplayUnavailable("viewer: cannot open a GL 3.3 core window");
     glfwMakeContextCurrent(window_);
     // Vsync paces the loop on a real display; the frame loop also paces itself (Xvfb has no vsync).
     glfwSwapInterval(opt_.hooks || opt_.screenshot_after > 0 ? 0 : 1);
     gl_ = load_gl_api(reinterpret_cast<GlGetProcAddress>(glfwGetProcAddress));
     program_ = std::make_unique<DisplayProgram>(gl_);
     {
-        // A software GL compiles each pipeline variant on first use (60 ms measured with llvmpipe,
-        // whose samplers are specialised on power-of-two texture sizes): run the preview's scaling
-        // blit now from a power-of-two and from another source, so that no camera change pays.
+        // A software GL compiles each pipeline variant on first use (llvmpipe specialises its
+        // samplers on power-of-two texture sizes; docs/viewer.md has the cost): run the preview's
+        // scaling blit now from a power-of-two and from another source, so that no camera change
+        // pays for it.
         unsigned fbo = 0, tex = 0;
         int cw = 0, ch = 0;
         ensure_color_target(gl_, fbo, tex, cw, ch, 8, 8);

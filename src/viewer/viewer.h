@@ -4,6 +4,7 @@
 // happens in a RenderSession; the window's thread never waits for a pass.
 #include <optional>
 #include <string>
+#include "core/error.h"
 #include "display/display.h"
 #include "render/launch.h"
 #include "render/session.h"
@@ -41,8 +42,16 @@ struct ViewerOptions {
     ViewerHooks* hooks = nullptr;  // measuring tools only; frames are then paced without vsync
 };
 
+// Thrown by run_viewer when GLFW cannot initialise (no display server, a refused connection) or
+// cannot open a GL 3.3 window, before anything was rendered: the caller may render headless.
+class DisplayUnavailable : public Error {
+public:
+    using Error::Error;
+};
+
 // Opens the window and runs until it is closed (or the screenshot is written). Returns the process
-// exit code. Throws Error when the scene cannot be loaded or no window can be opened.
+// exit code. Throws Error when the scene cannot be loaded, DisplayUnavailable when no window can
+// be opened.
 int run_viewer(const ViewerOptions& opt);
 
 }  // namespace candela

@@ -30,6 +30,7 @@ public:
     int run();
 
 private:
+    void init();  // everything after glfwInit: the scene, the window, the render session
     void open_window(int image_w, int image_h);
     void layout();
     void camera_input();        // window_input.cpp
