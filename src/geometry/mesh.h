@@ -61,6 +61,7 @@ struct Shape {
     bool has_color() const { return color_offset != kNone; }
     uint32_t first_triangle = 0;
     uint32_t triangle_count = 0;
+    int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder (no triangles)
 };
 
 }  // namespace candela

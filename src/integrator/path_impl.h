@@ -29,7 +29,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         vec3 wo_world = -glm::normalize(ray.d);
 
         // Emission reached by this ray.
-        if (sc.lights.emitter_of(hit.prim) >= 0) {
+        if (sc.lights.emitter_of(hit) >= 0) {
             vec3 Le = sc.lights.emitted(si, wo_world);
             if (!is_black(Le)) {
                 if (after_delta || mode == SamplingMode::Bsdf) {
