@@ -9,6 +9,7 @@
 #include <limits>
 #include "app/checkpoint.h"
 #include "core/error.h"
+#include "film/exr_layers.h"
 #include "film/film.h"
 #include "film/image_io.h"
 #include "headless/headless.h"
@@ -91,7 +92,13 @@ int run_headless(const HeadlessOptions& opt) {
     const uint64_t target = frames * uint64_t(spp_per_pass);
     if (target > std::numeric_limits<uint32_t>::max())
         throw Error("--frames x --spp-per-frame is " + std::to_string(target) + " samples per pixel, more than 2^32 - 1");
+    const std::vector<AovSpec>& aovs = st.integrator.aovs;
+    if (!aovs.empty() && !opt.checkpoint.empty())
+        throw Error(opt.checkpoint, 0, "checkpoints do not hold the aov integrator's layers; render it without --checkpoint");
+    if (!aovs.empty() && !opt.resume.empty())
+        throw Error(opt.resume, 0, "checkpoints do not hold the aov integrator's layers; render it without --resume");
     Film film(st.width, st.height);
+    configure_film(film, st);
     int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
 
     const bool checkpointing = !opt.checkpoint.empty();
@@ -147,8 +154,19 @@ int run_headless(const HeadlessOptions& opt) {
     if (checkpointing && whole_passes) save("final");
 
     Image img{film.width(), film.height(), film.resolve()};
-    if (ext == ".png") write_png_headless(opt.out, img, opt.display);
-    else write_linear_image(opt.out, img);
+    if (!aovs.empty() && ext == ".exr") {
+        std::vector<std::string> names = aov_channel_names(aovs);
+        std::vector<std::vector<float>> planes = film.resolve_aovs();
+        std::vector<ExrLayer> layers;
+        for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
+        write_exr_layers(opt.out, img, layers);
+    } else {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
+        if (ext == ".png") write_png_headless(opt.out, img, opt.display);
+        else write_linear_image(opt.out, img);
+    }
 
     const int sig = g_signal.load();
     if (!opt.quiet) {

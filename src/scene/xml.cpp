@@ -11,6 +11,7 @@
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
+#include "scene/plugins/render_factories.h"
 
 namespace candela {
 
@@ -377,20 +378,25 @@ void XmlLoader::load_default(pugi::xml_node n) {
 }
 
 void XmlLoader::load_integrator(pugi::xml_node n) {
-    Object o = read_object(n, "integrator");
-    if (o.type != "path") throw error(n, "unsupported integrator type '" + o.type + "' (candela supports: path)");
-    int max_depth = o.params.get_int("max_depth", -1);
-    int rr_depth = o.params.get_int("rr_depth", 5);
-    bool hide = o.params.get_bool("hide_emitters", false);
-    if (max_depth < -1) throw o.params.error("max_depth", "max_depth must be -1 (unbounded) or positive");
-    // Mitsuba's max_depth counts path segments, candela's counts scattering events. A Mitsuba depth
-    // of 0 renders black; that is never what a user wants, so it is rejected.
-    if (max_depth == 0) throw o.params.error("max_depth", "max_depth 0 renders a black image; use -1 or a value >= 1");
-    if (rr_depth <= 0) throw o.params.error("rr_depth", "rr_depth must be greater than zero");
-    if (hide) throw o.params.error("hide_emitters", "hide_emitters=true is not supported");
-    finish(o);
-    scene_.settings.max_depth = max_depth < 0 ? -1 : max_depth - 1;
-    scene_.settings.rr_depth = rr_depth;
+    // Wrappers (moment, aov) hold the integrator that renders the image: one, read in turn.
+    for (int level = 0;; ++level) {
+        Object o = read_object(n, "integrator");
+        if (read_integrator(o.type, o.params, scene_.settings, o.line) == IntegratorRole::Renders) {
+            finish(o);
+            return;
+        }
+        Nested* inner = nullptr;
+        for (Nested& c : o.nested) {
+            if (c.tag != "integrator") continue;
+            if (inner) throw error(c.node, o.what() + " with more than one nested integrator (candela renders one)");
+            inner = &c;
+        }
+        if (!inner) throw error(n, o.what() + " needs a nested <integrator>");
+        if (level >= 8) throw error(n, "integrators nested more than 8 deep");
+        inner->used = true;
+        finish(o);
+        n = inner->node;
+    }
 }
 
 void XmlLoader::load_film(pugi::xml_node n) {
@@ -408,12 +414,12 @@ void XmlLoader::load_film(pugi::xml_node n) {
     std::string ff = o.params.get_string("file_format", "openexr");
     if (ff != "openexr") throw o.params.error("file_format", "unsupported file_format '" + ff + "' (openexr)");
     bool have_filter = false;
+    scene_.settings.filter = gaussian_filter();  // Mitsuba's default without an <rfilter>
     for (Nested& c : o.nested) {
         if (c.tag != "rfilter") continue;
         if (have_filter) throw error(c.node, "more than one <rfilter>");
         Object f = read_object(c.node, "rfilter");
-        if (f.type != "box")
-            throw error(c.node, "unsupported rfilter type '" + f.type + "' (candela renders with a box filter only)");
+        scene_.settings.filter = read_rfilter(f.type, f.params, f.line);
         finish(f);
         c.used = have_filter = true;
     }
@@ -465,6 +471,7 @@ void XmlLoader::load_sensor(pugi::xml_node n) {
 
     scene_.settings.width = 768;  // Mitsuba's film and sampler defaults, when those are absent
     scene_.settings.height = 576;
+    scene_.settings.filter = gaussian_filter();
     scene_.settings.spp = 4;
     scene_.settings.seed = 0;
     bool film = false, sampler = false;
@@ -885,6 +892,7 @@ SceneDescription XmlLoader::load() {
         scene_.settings.width = 768;
         scene_.settings.height = 576;
         scene_.settings.spp = 4;
+        scene_.settings.filter = gaussian_filter();
     }
     return std::move(scene_);
 }
