@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, and runs candela. With a display it opens the
 # viewer on the given scene (default: the built-in Cornell box); without one it renders the
-# default scene headless to out/candela.png. Extra arguments go to candela.
+# default scene headless to out/candela.png, unless the arguments name an --out of their own.
+# Extra arguments go to candela.
 # Usage: bash scripts/run.sh [SCENE] [candela options]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -10,6 +11,11 @@ bash scripts/build.sh >/dev/null
 if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
   exec build/bin/candela "$@"
 fi
+for arg in "$@"; do
+  case "$arg" in
+    --out | --out=*) exec build/bin/candela "$@" ;;  # a second --out would be a usage error
+  esac
+done
 mkdir -p out
 echo "run.sh: no display: rendering headless to out/candela.png" >&2
 exec build/bin/candela "$@" --out out/candela.png

@@ -1,11 +1,18 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the tests under ctest.
-# Usage: bash scripts/test.sh [--sanitize | --tsan]
+# Usage: bash scripts/test.sh [--debug | --sanitize | --tsan]
 #   (none)      the Release build in build/, every test
+#   --debug     the Debug build (-O0, assertions on) in build-debug/, every test but the heavy
+#               statistical and brute-force ones, which at -O0 run 10-30x their Release time
+#               (the chi-square tests, the image and furnace tests, brute-force accelerator
+#               comparisons): they check numbers, which Release and ASan already cover, where a
+#               Debug run is for assertions and code that -O3 could hide. CANDELA_DEBUG_EXCLUDE=REGEX
+#               replaces the regex (an empty value runs everything). See docs/reliability.md.
 #   --sanitize  the ASan+UBSan build in build-asan/, every test (about 7x the Release suite's CPU
 #               time, see docs/reliability.md); CANDELA_ASAN_EXCLUDE=REGEX leaves tests out
 #               (ctest -E), e.g. '^(BsdfChi2|ImageCornell|KdTree)\.' for a quick local run
-#   --tsan      a ThreadSanitizer build in build-tsan/, the render session tests (Session.*), with
+#   --tsan      a ThreadSanitizer build in build-tsan/, the render session and the viewer's use of it
+#               without a window (Session.*, ViewerFrontEnd.*, SceneSplit.*), with
 #               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
 #               cannot see its barriers; one OpenMP thread per pass leaves TSan the session's own
 #               threads (worker and front end) to check. See docs/reliability.md.
@@ -18,6 +25,13 @@ case "$mode" in
     dir=$(bash scripts/build.sh | tail -n 1)
     cd "$dir"
     ctest --output-on-failure -j"$(nproc)" --timeout 600
+    ;;
+  --debug)
+    dir=$(bash scripts/build.sh --debug | tail -n 1)
+    cd "$dir"
+    heavy='^(BsdfChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself)\.?'
+    exclude=${CANDELA_DEBUG_EXCLUDE-$heavy}
+    ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
     ;;
   --sanitize)
     dir=$(bash scripts/build.sh --sanitize | tail -n 1)
@@ -41,7 +55,7 @@ case "$mode" in
     fi
     cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2
     export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp"
-    OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*'
+    OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*:ViewerFrontEnd.*:SceneSplit.*'
     ;;
   *) echo "test.sh: unknown option '$mode'" >&2; exit 2 ;;
 esac

@@ -371,3 +371,49 @@ TEST(Display, HeadlessContextIsCoreProfile33OrLater) {
     // Contexts come and go on one thread (a fresh one per PNG).
     for (int i = 0; i < 3; ++i) candela::display_to_srgb8(constant_image(2, 2, 0.5f), {});
 }
+
+// Tiles assemble into exactly the untiled image: random values (NaN, Inf, negative, large
+// included), uneven tile sizes with partial tiles at the right and bottom, two exposures.
+TEST(Display, TiledEqualsUntiledByteForByte) {
+    const int w = 53, h = 37;
+    Image img{w, h, std::vector<float>(size_t(w) * h * 3)};
+    uint32_t state = 12345;
+    for (float& v : img.rgb) {
+        state = state * 1664525u + 1013904223u;
+        v = float(state >> 8) * 0x1p-24f * 1.5f - 0.1f;
+    }
+    img.rgb[7] = std::numeric_limits<float>::quiet_NaN();
+    img.rgb[100] = std::numeric_limits<float>::infinity();
+    img.rgb[2000] = -std::numeric_limits<float>::infinity();
+    for (float exposure : {0.f, 1.5f}) {
+        DisplaySettings ds;
+        ds.exposure = exposure;
+        const std::vector<unsigned char> whole = candela::display_to_srgb8(img, ds);
+        for (int tile : {1, 7, 16, 36, 52}) {
+            const std::vector<unsigned char> tiled = candela::display_to_srgb8(img, ds, tile);
+            ASSERT_EQ(tiled.size(), whole.size());
+            EXPECT_TRUE(tiled == whole) << "tile " << tile << ", exposure " << exposure;
+        }
+    }
+}
+
+// Wider than GL's texture limit (16384 on llvmpipe): drawn in tiles, every pixel right.
+TEST(Display, WiderThanTheGlLimit) {
+    const int w = 20000, h = 2;
+    Image img{w, h, std::vector<float>(size_t(w) * h * 3)};
+    for (int x = 0; x < w; ++x)
+        for (int y = 0; y < h; ++y)
+            for (int c = 0; c < 3; ++c) img.rgb[(size_t(y) * w + x) * 3 + c] = float(x % 256) / 255.f;
+    const std::vector<unsigned char> px = candela::display_to_srgb8(img, {});
+    ASSERT_EQ(px.size(), size_t(w) * h * 4);
+    for (int x = 0; x < w; x += 97)
+        ASSERT_NEAR(int(px[4 * size_t(x)]), expected_byte(double(float(x % 256) / 255.f), 0), 1) << x;
+    EXPECT_EQ(px[4 * size_t(w - 1)], px[4 * size_t(2 * w - 1)]);
+}
+
+TEST(Display, ForcedGlFailureThrows) {
+    setenv("CANDELA_TEST_FAIL_GL", "1", 1);
+    EXPECT_THROW(candela::display_to_srgb8(constant_image(4, 4, 0.5f), {}), Error);
+    unsetenv("CANDELA_TEST_FAIL_GL");
+    EXPECT_NO_THROW(candela::display_to_srgb8(constant_image(4, 4, 0.5f), {}));
+}

@@ -23,6 +23,7 @@
 #include "sampling/warp.h"
 #include "scene/obj.h"
 #include "scene/scene.h"
+#include "support/shared_assets.h"
 
 using namespace candela;
 
@@ -51,7 +52,14 @@ std::shared_ptr<const Scene> make_scene(const std::vector<vec3>& pos, const std:
 
 struct Counts {
     uint64_t rays = 0, self_hits = 0, target_hits = 0, points = 0;
+    uint64_t rounding_target_hits = 0;  // of target_hits: the target triangle's own float t error
 };
+
+// The ray's t at the plane of triangle (p0, p1, p2), in double from the same float inputs.
+double plane_t(const Ray& r, vec3 p0, vec3 p1, vec3 p2) {
+    const dvec3 n = glm::cross(dvec3(p1) - dvec3(p0), dvec3(p2) - dvec3(p0));
+    return glm::dot(n, dvec3(p0) - dvec3(r.o)) / glm::dot(n, dvec3(r.d));
+}
 
 // Random start points on random triangles of the scene; `offset` false spawns from the raw point
 // (the control that shows the test can fail).
@@ -119,6 +127,11 @@ Counts probe(const Scene& sc, uint64_t seed, int n_points, int dirs_per_point, b
             if (hits_triangle(mesh, tri, shadow)) ++c.self_hits;
             if (hits_triangle(mesh, other, shadow)) {
                 ++c.target_hits;
+                // The target triangle reported short of tmax although its plane is crossed at or
+                // beyond tmax: the intersector's rounding of t (see SliverShadowRayEndsAtItsTarget).
+                vec3 q0, q1, q2;
+                mesh.vertices(other, q0, q1, q2);
+                if (plane_t(shadow, q0, q1, q2) >= double(shadow.tmax)) ++c.rounding_target_hits;
                 if (std::getenv("CANDELA_DEBUG_SELF"))
                     std::printf("target hit: from (%.9g %.9g %.9g) n (%g %g %g) to (%.9g %.9g %.9g) err (%g %g %g) n (%g %g %g)\n",
                                 si.p.x, si.p.y, si.p.z, si.ng.x, si.ng.y, si.ng.z, to.p.x, to.p.y, to.p.z, to.p_error.x,
@@ -185,19 +198,21 @@ TEST(SelfIntersection, RandomTrianglesNeverHitThemselves) {
         // Half the points come from shooting at the triangle, which misses most slivers.
         EXPECT_GT(c.points, std::string(fam) == "sliver" ? 4500u : 9000u) << fam;
         EXPECT_EQ(c.self_hits, 0u) << fam;
-        // Known, not fixed: one shadow ray in ~270k between two axis-aligned planes at exactly 0
-        // (zero error bound, so no offset at either end) reports the target's own triangle short of
-        // tmax = 1 - kShadowEpsilon (from (0.214, -0.121, 0) on z = 0 to (-0.065, 0, 0.256) on
-        // y = 0); the test pins it at that count so that any regression shows.
-        EXPECT_LE(c.target_hits, std::string(fam) == "axis0" ? 1u : 0u) << fam;
+        // No shadow ray may report its target's own triangle, but for the one ray of "axis0" whose
+        // target is on a sliver: the ray does not cross the sliver's plane before tmax, the float
+        // t of the watertight test is 2.7e-4 short, more than kShadowEpsilon
+        // (SelfIntersection.SliverShadowRayEndsAtItsTarget derives it). Exactly that one, with
+        // these seeds; any other target hit is a failure.
+        EXPECT_EQ(c.target_hits - c.rounding_target_hits, 0u) << fam;
+        EXPECT_EQ(c.rounding_target_hits, std::string(fam) == "axis0" ? 1u : 0u) << fam;
     }
 }
 
 // The same property on a real mesh, through the whole scene as well: the closest hit of a spawned
 // ray is never its own triangle (neighbours sharing an edge may legitimately be hit).
 TEST(SelfIntersection, BunnyNeverHitsItself) {
-    const std::string path = std::string(CANDELA_SHARED_DIR) + "/assets/meshes/bunny.obj";
-    if (!std::ifstream(path)) GTEST_SKIP() << path << " is absent";
+    const std::string path = candela::test::shared_mesh_path("bunny.obj");
+    CANDELA_REQUIRE_SHARED_MESH(path);
     ObjData obj = read_obj(path, false);
     std::vector<uvec3> tris;
     for (const ObjGroup& g : obj.groups) tris.insert(tris.end(), g.triangles.begin(), g.triangles.end());
@@ -228,6 +243,40 @@ TEST(SelfIntersection, BunnyNeverHitsItself) {
                     (unsigned long long)c.target_hits, (unsigned long long)own);
         EXPECT_EQ(own, 0u) << "scale " << scale;
     }
+}
+
+// The shadow ray of "axis0" that reports its target's triangle: from (0.214, -0.121, 0) on the
+// plane z = 0 to a point on a sliver of the plane y = 0 (edges 0.8 long, area 1e-4: its vertices
+// are nearly collinear). It is not a self-intersection, and no origin offset could change it:
+//   * both ends have zero error along their normals (the plane coordinate of every vertex is
+//     exactly 0), so neither is offset, and o.y + d.y = 0.121282294 - 0.121282294 = 0 exactly: in
+//     exact arithmetic on the float ray the sliver's plane is crossed at t = 1 > tmax = 1 - 1e-4;
+//   * the watertight test shears the sliver along the ray, where its edge functions are
+//     differences of products of ~0.06 that cancel to det = -7.4e-5 (a factor ~3000), so float
+//     rounding (~1e-8 in each sheared coordinate) moves t by ~1e-4 relative: t = 0.99973;
+//   * the test's own error bound says as much: delta_t (pbrt-v4 6.8.7) is 0.1 here, so its t
+//     cannot tell 0.99973 from 1. A shadow ray ending on such a sliver can be shadowed by it
+//     (once in ~270k rays between random axis-plane triangles; a sliver light is not realistic).
+// Not fixed: refining such hits in double (tried) changes which of several triangles hit within
+// ulps of a shared vertex is the closest, depending on the order they are met in, so brute force
+// and the k-d tree disagree (KdTree.CoherentOriginsMatchBruteForce); doing it right needs the
+// float interval tests widened by delta_t in both the scalar and the 4-wide test.
+TEST(SelfIntersection, SliverShadowRayEndsAtItsTarget) {
+    const vec3 q0(0.491201222f, 0.f, 0.427544057f), q1(0.387188911f, 0.f, 0.395229101f),
+        q2(-0.315971136f, 0.f, 0.178404927f);
+    Ray r;
+    r.o = vec3(0.214067101f, -0.121282294f, 0.f);
+    r.d = vec3(-0.27948913f, 0.121282294f, 0.255722135f);
+    r.tmax = 1.f - kShadowEpsilon;
+    EXPECT_EQ(r.o.y + r.d.y, 0.f);
+    EXPECT_EQ(plane_t(r, q0, q1, q2), 1.0);
+    TriangleHit th;
+    ASSERT_TRUE(intersect_triangle(r, RayShear(r.d), q0, q1, q2, th));
+    EXPECT_NEAR(th.t, 0.99973f, 1e-5f);
+    // A well-conditioned triangle of the same plane through the same target ends the ray at tmax.
+    const vec3 target = r.o + r.d;
+    EXPECT_FALSE(intersect_triangle(r, RayShear(r.d), target + vec3(-0.5f, 0.f, -0.5f), target + vec3(0.5f, 0.f, -0.5f),
+                                    target + vec3(0.f, 0.f, 0.5f), th));
 }
 
 // Control: without the origin offset the same probe finds self-hits, so the tests above can fail.

@@ -2,6 +2,7 @@
 // normalised, and checks that the chi-square machinery (tests/support/stats) rejects wrong pdfs
 // and wrong samplers. Also the special functions the p-values rest on.
 #include <gtest/gtest.h>
+#include <gtest/gtest-spi.h>
 #include <cmath>
 #include "sampling/warp.h"
 #include "support/stats.h"
@@ -125,6 +126,26 @@ TEST(Stats, ChiSquareIsCalibratedUnderTheNull) {
     // 0.1 +- 4.5 sd: a broken dof or pooling moves it far outside (fixed seed: deterministic).
     EXPECT_GT(below, 1);
     EXPECT_LT(below, 40);
+}
+
+// A chi-square test left with no degree of freedom (everything pooled into one cell, or as many
+// constraints as cells) tests nothing: it must fail the test that ran it and give a p that passes
+// no comparison. It used to return p = 1, which passed silently.
+TEST(Stats, ChiSquareWithoutDegreesOfFreedomFails) {
+    ChiSquareResult r;
+    // Four cells expecting 1 each (min_expected 5): all pooled into one cell, dof 0.
+    EXPECT_NONFATAL_FAILURE(r = chi_square_counts({4, 0, 0, 0}, {1, 1, 1, 1}), "0 degrees of freedom");
+    EXPECT_EQ(r.dof, 0);
+    EXPECT_TRUE(std::isnan(r.p_value)) << r.describe();
+    EXPECT_FALSE(r.p_value >= 0.01);
+    EXPECT_FALSE(r.p_value < 0.01);
+    // Two cells, one constraint besides the total: dof 0 as well.
+    EXPECT_NONFATAL_FAILURE(r = chi_square_counts({50, 50}, {50, 50}, 5.0, 1), "0 degrees of freedom");
+    EXPECT_TRUE(std::isnan(chi_square_sf(1.0, 0)));
+    // Control: the same counts on enough cells are a valid test.
+    r = chi_square_counts({50, 50}, {50, 50});
+    EXPECT_EQ(r.dof, 1);
+    EXPECT_NEAR(r.p_value, 1.0, 1e-12);
 }
 
 // ---- the warps ------------------------------------------------------------------------------------

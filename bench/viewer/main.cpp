@@ -8,11 +8,77 @@
 #include <cstdio>
 #include <thread>
 #include "core/error.h"
+#include "viewer/front_end.h"
 #include "viewer/viewer.h"
 
 using namespace candela;
 
 namespace {
+
+// The measurement, as viewer hooks: scripted camera moves and what each frame cost.
+struct Benchmark : ViewerHooks {
+    double duration = 10;       // seconds of measurement, after the first full-resolution pass
+    double move_every = 0.25;   // seconds between scripted camera changes (a small orbit step)
+    int moves_per_burst = 1;    // consecutive frames that each change the camera (a "drag")
+    bool paused = false;        // full passes paused: the window's own cost, previews only
+    // Results.
+    std::vector<double> frame_ms;      // per frame, from the end of the event wait to the swap
+    std::vector<double> frame_cpu_ms;  // the same, in CPU time of the window's thread: what the
+                                       // frame costs on an idle core (with LP_NUM_THREADS=0 the
+                                       // software rasteriser runs in this thread too)
+    std::vector<double> update_ms;     // camera change -> end of the first frame showing its image
+    std::vector<bool> frame_new_image;
+    int frames = 0;
+
+    double start = 0, next_move = 0, change_time = -1;
+    uint64_t change_gen = 0;
+    bool waiting_gen = false;
+    int burst_left = 0;
+
+    void started(ViewerFrontEnd& fe) override {
+        if (paused) fe.session().set_paused(true);
+    }
+    void before_panel(ViewerFrontEnd& fe, double now) override {
+        if (start == 0) return;
+        if (burst_left == 0 && now >= next_move) {
+            burst_left = moves_per_burst;
+            next_move = now + move_every;
+        }
+        if (burst_left > 0) {
+            --burst_left;
+            fe.camera().orbit(0.01f, 0.f);
+            fe.camera_changed(now);
+            if (change_time < 0) {
+                change_time = now;
+                waiting_gen = true;
+            }
+        }
+    }
+    bool after_frame(ViewerFrontEnd& fe, const Frame& f) override {
+        const SessionImage& img = fe.image();
+        if (start == 0) {
+            // Start once the first full pass is on screen: the steady state of a session.
+            if (img.rgb.empty() || (img.preview && !paused)) return true;
+            start = next_move = f.end;
+        }
+        if (f.end - start > duration) return false;
+        frame_ms.push_back((f.end - f.start) * 1e3);
+        frame_cpu_ms.push_back(f.cpu_ms);
+        frame_new_image.push_back(f.new_image);
+        ++frames;
+        // The change was sent in this frame once nothing is left unsent.
+        if (waiting_gen && !fe.dirty()) {
+            change_gen = fe.sent_generation();
+            waiting_gen = false;
+        }
+        // A change is "shown" at the end of the first frame whose image comes from it.
+        if (change_time >= 0 && !waiting_gen && img.generation >= change_gen) {
+            update_ms.push_back((f.end - change_time) * 1e3);
+            change_time = -1;
+        }
+        return true;
+    }
+};
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) return 0;
@@ -26,7 +92,7 @@ double percentile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
     CLI::App app{"candela-bench-viewer: viewer frame times and camera-change latency"};
     ViewerOptions vo;
-    ViewerBenchmark b;
+    Benchmark b;
     int size = 512;
     app.add_option("scene", vo.scene, "Scene file (default: the built-in Cornell box)");
     app.add_option("--size", size, "Image width and height");
@@ -41,7 +107,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     vo.overrides.width = size;
     vo.overrides.height = size;
-    vo.benchmark = &b;
+    vo.hooks = &b;
     vo.render_priority = parse_render_priority(priority);
     try {
         run_viewer(vo);

@@ -2,6 +2,7 @@
 #include <omp.h>
 #include <algorithm>
 #include <cmath>
+#include "core/interrupt.h"
 
 namespace candela {
 namespace {
@@ -40,6 +41,7 @@ HybridGridAccel::HybridGridAccel(const Mesh& mesh, const GridOptions& opt) : mes
         return std::clamp(int((x - bounds_.min[a]) * inv_cell_[a]), 0, res_[a] - 1);
     };
     for (uint32_t i = 0; i < n; ++i) {
+        if (i % 4096 == 0) throw_if_interrupted();
         AABB b = mesh.triangle_bounds(i);
         int lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
@@ -66,12 +68,14 @@ HybridGridAccel::HybridGridAccel(const Mesh& mesh, const GridOptions& opt) : mes
     kd.parallel = false;  // parallel over cells instead
 #pragma omp parallel for schedule(dynamic, 1)
     for (int64_t k = 0; k < int64_t(occupied.size()); ++k) {
+        if (interrupt_requested()) continue;
         const size_t c = occupied[size_t(k)];
         const int x = int(c % res_[0]), y = int((c / res_[0]) % res_[1]), z = int(c / (size_t(res_[0]) * res_[1]));
         AABB cb = cell_box(x, y, z);
         trees_[size_t(k)].build(mesh, &bins[c], &cb, kd);
         std::vector<uint32_t>().swap(bins[c]);
     }
+    throw_if_interrupted();  // the cells' builds stop early and only return inside the loop
     // Drop cells whose triangles all missed them after clipping.
     std::vector<KdTree> kept;
     for (size_t k = 0; k < occupied.size(); ++k) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "geometry/triangle.h"
 
 namespace candela {
@@ -27,6 +28,25 @@ struct Event {
 };
 
 enum : uint8_t { kBoth = 0, kLeftOnly = 1, kRightOnly = 2 };
+
+// Sorts the events as std::stable_sort would (equal events keep their triangle order), as a merge
+// sort of 2^18-event runs, so that an interrupt is noticed within one run or merge of a
+// multi-second sort. Returns false when interrupted (the order is then unspecified).
+bool sort_events(std::vector<Event>& ev) {
+    constexpr size_t kRun = size_t(1) << 18;
+    const size_t n = ev.size();
+    for (size_t i = 0; i < n; i += kRun) {
+        if (interrupt_requested()) return false;
+        std::stable_sort(ev.begin() + std::ptrdiff_t(i), ev.begin() + std::ptrdiff_t(std::min(n, i + kRun)));
+    }
+    for (size_t width = kRun; width < n; width *= 2)
+        for (size_t i = 0; i + width < n; i += 2 * width) {
+            if (interrupt_requested()) return false;
+            auto first = ev.begin() + std::ptrdiff_t(i);
+            std::inplace_merge(first, first + std::ptrdiff_t(width), ev.begin() + std::ptrdiff_t(std::min(n, i + 2 * width)));
+        }
+    return true;
+}
 
 // Bounds of the part of triangle v inside `box` (Sutherland-Hodgman in double), rounded outwards
 // and never larger than the box or the triangle's own bounds. Empty when the triangle misses it.
@@ -113,6 +133,9 @@ public:
     // `stalls`: consecutive ancestors whose split left one child with all of their triangles.
     std::unique_ptr<BuildNode> build(std::vector<Event>& events, size_t n, const AABB& box, int depth, int stalls) {
         auto node = std::make_unique<BuildNode>();
+        // An exception must not leave an OpenMP task: an interrupted build unwinds as empty
+        // leaves, and the tree's owner throws outside the parallel region.
+        if (interrupt_requested()) return node;
         const float leaf_cost = opt_.intersection_cost * float(n);
         const float sa = box.surface_area();
         float best_cost = kInfinity;
@@ -211,7 +234,12 @@ private:
         const vec3 ext = box.extent();
         size_t i = 0;
         const size_t m = ev.size();
-        while (i < m) {
+        for (size_t poll = 0; i < m; ++poll) {
+            // A big node's sweep takes a while; on an interrupt no split is chosen (a leaf).
+            if (poll % 65536 == 0 && interrupt_requested()) {
+                best_dim = -1;
+                return;
+            }
             const float pos = ev[i].pos;
             const int d = ev[i].dim;
             size_t pe = 0, pp = 0, ps = 0;
@@ -269,6 +297,13 @@ constexpr float kWidenDown = 1.f - 1.f / 65536.f;
 
 // ---- KdTree ---------------------------------------------------------------------------------
 
+void KdTree::interrupted_build() {
+    nodes_.clear();
+    blocks_.clear();
+    bounds_ = AABB();
+    stats_ = {};
+}
+
 void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AABB* clip, const KdBuildOptions& opt) {
     nodes_.clear();
     blocks_.clear();
@@ -283,11 +318,13 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     }
     const std::vector<uint32_t>& list = *tris;
     if (list.empty()) return;
+    if (interrupt_requested()) return interrupted_build();
 
     std::vector<Event> events;
     events.reserve(list.size() * 6);
     size_t n = 0;
     for (uint32_t i = 0; i < list.size(); ++i) {
+        if (i % 4096 == 0 && interrupt_requested()) return interrupted_build();
         vec3 v[3];
         mesh.vertices(list[i], v[0], v[1], v[2]);
         AABB b;
@@ -304,7 +341,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         ++n;
     }
     if (n == 0) return;
-    std::sort(events.begin(), events.end());
+    if (!sort_events(events)) return interrupted_build();
 
     Builder builder(mesh, list, opt, n);
     std::unique_ptr<BuildNode> root;
@@ -316,6 +353,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     } else {
         root = builder.build(events, n, bounds_, 0, 0);
     }
+    if (interrupt_requested()) return interrupted_build();
 
     // Layout: the two children of a node are adjacent (a sibling pair), so an interior node stores
     // one index. Pairs are packed in treelets of up to 4 pairs (8 nodes, 64 bytes), filled breadth
@@ -565,9 +603,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
         // holds the origin, so the next node is always the child on the origin's side (the exact
         // test of the general step below), and the other child is pushed when the ray reaches the
         // plane inside the segment. The general step visits the same nodes with the same
-        // intervals, but its branches on tp mispredict here: masks instead of branches make the
-        // walk from the root to a surface point (half of a bounce or shadow ray's node visits)
-        // ~10-20% faster (docs/accel.md).
+        // intervals, but its branches on tp mispredict here, so this walk (half of a bounce or
+        // shadow ray's node visits) uses masks instead (docs/accel.md has the measurements).
         const __m128 zero = _mm_setzero_ps(), up = _mm_set_ss(kWidenUp), down = _mm_set_ss(kWidenDown);
         const __m128 inf = _mm_set_ss(kInfinity);
         while (!node->leaf()) {
@@ -610,8 +647,8 @@ bool KdTree::trace(Ray& ray, Hit* hit) const {
             // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
             // for a ray lying in the plane, which then visits both children over the whole interval
             // (std::max / std::min return their first argument for a NaN second). Branches, not
-            // selects: a branch-free step measured 9% slower on bounce rays and much slower on
-            // (well predicted) primary rays (docs/accel.md).
+            // selects: they predict well here, and a branch-free step makes every step wait for
+            // its comparisons (docs/accel.md has the measurements).
             // An empty child is never entered nor stacked: the walk goes on with the other one
             // (its interval trimmed as if the empty one had been visited), or with the stack.
             const uint32_t first_empty = node->empty_child(!below_first), second_empty = node->empty_child(below_first);

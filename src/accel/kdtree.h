@@ -16,6 +16,7 @@
 #include <vector>
 #include "accel/accel.h"
 #include "core/aabb.h"
+#include "core/interrupt.h"
 
 namespace candela {
 
@@ -53,7 +54,10 @@ public:
     KdTree() = default;
     // Builds over triangles `tris` of `mesh` (all of them when tris is null). When `clip` is given,
     // every triangle is clipped to it first: the tree then covers only the part of space inside
-    // `clip` (used by the grid, whose cells each hold a tree).
+    // `clip` (used by the grid, whose cells each hold a tree). Polls interrupt_requested()
+    // (core/interrupt.h) per node: once it is set the build stops and leaves the tree empty. It
+    // never throws Interrupted itself (it may run inside an OpenMP region, which an exception
+    // must not leave): the caller calls throw_if_interrupted() afterwards.
     void build(const Mesh& mesh, const std::vector<uint32_t>* tris = nullptr, const AABB* clip = nullptr,
                const KdBuildOptions& opt = {});
 
@@ -100,6 +104,7 @@ public:
 private:
     template <bool Shadow>
     bool trace(Ray& ray, Hit* hit) const;
+    void interrupted_build();
 
     std::vector<Node> nodes_;
     std::vector<TriBlock> blocks_;  // the leaves' triangles, leaf by leaf
@@ -111,6 +116,7 @@ class KdTreeAccel final : public Accel {
 public:
     explicit KdTreeAccel(const Mesh& mesh, const KdBuildOptions& opt = {}) : mesh_(&mesh) {
         tree_.build(mesh, nullptr, nullptr, opt);
+        throw_if_interrupted();
     }
     bool intersect(Ray& ray, Hit& hit) const override { return tree_.intersect(ray, hit); }
     bool occluded(const Ray& ray) const override { return tree_.occluded(ray); }

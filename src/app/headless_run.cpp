@@ -3,12 +3,18 @@
 #include <unistd.h>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <mutex>
+#include <optional>
+#include <thread>
 #include "app/checkpoint.h"
 #include "core/error.h"
+#include "core/interrupt.h"
+#include "core/progress.h"
 #include "film/exr_layers.h"
 #include "film/film.h"
 #include "film/image_io.h"
@@ -23,11 +29,14 @@ namespace {
 std::atomic<int> g_signal{0};         // the first SIGINT/SIGTERM received, 0 if none
 std::atomic<bool> g_stop_now{false};  // the render stops within a tile
 std::atomic<bool> g_finish_pass{false};  // checkpointing: the first signal waits for the pass
+std::atomic<bool> g_rendering{false};    // the scene is ready and passes run
 static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
 
 extern "C" void on_signal(int sig) {
     int none = 0;
-    if (g_signal.compare_exchange_strong(none, sig) && g_finish_pass.load()) {
+    const bool first = g_signal.compare_exchange_strong(none, sig);
+    request_interrupt();  // stops a scene load or accelerator build: they have no pass to finish
+    if (first && g_finish_pass.load() && g_rendering.load()) {
         static const char msg[] = "\ncandela: finishing the current pass for the checkpoint (signal again to stop now)\n";
         ssize_t n = ::write(STDERR_FILENO, msg, sizeof msg - 1);  // async-signal-safe, unlike stdio
         (void)n;
@@ -54,16 +63,35 @@ void check_writable(const std::string& path) {
     if (::access(dir.c_str(), W_OK) != 0) throw Error(path, 0, "cannot write in directory '" + dir + "'");
 }
 
-void progress_bar(uint64_t done, uint64_t total, double secs, double msps) {
-    const int width = 30;
-    int filled = total > 0 ? int(double(width) * double(done) / double(total)) : 0;
-    char bar[width + 1];
-    for (int i = 0; i < width; ++i) bar[i] = i < filled ? '=' : (i == filled ? '>' : ' ');
-    bar[width] = 0;
-    std::fprintf(stderr, "\r[%s] %llu/%llu spp  %.2f Msamples/s  %.1fs ", bar, (unsigned long long)done,
-                 (unsigned long long)total, msps, secs);
-    std::fflush(stderr);
-}
+// Cuts the pass in flight at the deadline: sets `stop` (the pass's cancel flag, polled per tile)
+// and `fired`. Between passes the loop checks the clock itself.
+class Deadline {
+public:
+    Deadline(std::chrono::steady_clock::time_point when, std::atomic<bool>& stop, std::atomic<bool>& fired)
+        : thread_([this, when, &stop, &fired] {
+              std::unique_lock<std::mutex> lock(mutex_);
+              if (!cv_.wait_until(lock, when, [this] { return done_; })) {
+                  fired = true;
+                  stop = true;
+              }
+          }) {}
+    ~Deadline() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            done_ = true;
+        }
+        cv_.notify_all();
+        thread_.join();
+    }
+    Deadline(const Deadline&) = delete;
+    Deadline& operator=(const Deadline&) = delete;
+
+private:
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    bool done_ = false;  // guarded by mutex_; declared before thread_, which reads it
+    std::thread thread_;
+};
 
 }  // namespace
 
@@ -79,9 +107,24 @@ int run_headless(const HeadlessOptions& opt) {
     g_signal = 0;
     g_stop_now = false;
     g_finish_pass = !opt.checkpoint.empty();
+    g_rendering = false;
+    clear_interrupt();
     install_signal_handlers();
+    auto nothing_written = [&](const char* when) {
+        const int sig = g_signal.load();
+        std::string kept = opt.checkpoint.empty() ? opt.out + " left as it was"
+                                                   : opt.out + " and " + opt.checkpoint + " left as they were";
+        std::fprintf(stderr, "candela: %s %s: nothing written (%s)\n", sig == SIGTERM ? "terminated" : "interrupted",
+                     when, kept.c_str());
+        return 128 + (sig ? sig : SIGINT);
+    };
 
-    std::shared_ptr<const Scene> scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    std::shared_ptr<const Scene> scene_ptr;
+    try {
+        scene_ptr = prepare_scene(opt.scene, opt.overrides);
+    } catch (const Interrupted&) {
+        return nothing_written("while loading the scene");
+    }
     const Scene& scene = *scene_ptr;
     const RenderSettings& st = scene.settings;
     if (!opt.quiet)
@@ -126,12 +169,22 @@ int run_headless(const HeadlessOptions& opt) {
         }
     };
 
+    g_rendering = true;
     const bool tty = isatty(fileno(stderr)) && !opt.quiet;
     uint64_t samples = 0, rays = 0;
     bool whole_passes = true;  // false once a pass was cut short: the film is no longer checkpointable
-    while (spp_done < target && g_signal == 0) {
+    // The time limit cuts the pass in flight (within a tile per thread), not only between passes.
+    std::atomic<bool> time_up{false};
+    std::optional<Deadline> deadline;
+    if (opt.time_limit > 0)
+        deadline.emplace(t0 + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(opt.time_limit)),
+                         g_stop_now, time_up);
+    while (spp_done < target && g_signal == 0 && !time_up) {
         double elapsed = std::chrono::duration<double>(clock::now() - t0).count();
-        if (opt.time_limit > 0 && elapsed >= opt.time_limit) break;
+        if (opt.time_limit > 0 && elapsed >= opt.time_limit) {
+            time_up = true;
+            break;
+        }
         int n = int(std::min<uint64_t>(uint64_t(spp_per_pass), target - spp_done));
         PassStats ps = Renderer::render_pass(scene, film, spp_done, n, threads, &g_stop_now);
         samples += ps.samples;
@@ -146,26 +199,70 @@ int run_headless(const HeadlessOptions& opt) {
             save("periodic");
         if (tty) {
             double s = std::chrono::duration<double>(clock::now() - t0).count();
-            progress_bar(spp_done, target, s, s > 0 ? double(samples) / s * 1e-6 : 0.0);
+            std::string line = progress_line(spp_done, target, uint64_t(film.width()) * uint64_t(film.height()), s,
+                                             s > 0 ? double(samples) / s : 0.0, opt.time_limit);
+            std::fprintf(stderr, "\r%s ", line.c_str());
+            std::fflush(stderr);
         }
     }
+    deadline.reset();
     double secs = std::chrono::duration<double>(clock::now() - t0).count();
     if (tty) std::fprintf(stderr, "\n");
+    // A stopped render without one whole pass must not replace an earlier good image with a
+    // black or patchy one (nor a checkpoint with an empty one).
+    if (g_signal != 0 && spp_done == 0) return nothing_written("before the first pass finished");
+    // A cut pass leaves each pixel the plain mean of the samples it has: those it reached have one
+    // pass more than the rest. Still an unbiased estimate per pixel, only noisier in places.
+    const bool stopped_by_limit = time_up && spp_done < target;
+    uint64_t reached = 0;  // pixels with samples of the cut pass
+    uint32_t most = spp_done;
+    if (!whole_passes) {
+        for (uint32_t c : film.counts()) {
+            reached += c > spp_done;
+            most = std::max(most, c);
+        }
+        if (reached == 0) whole_passes = true;  // cut before its first tile: the film holds whole passes
+    }
+    if (stopped_by_limit && reached > 0 && !opt.quiet) {
+        std::fprintf(stderr, "candela: the time limit cut the last pass short: %.1f%% of the pixels have %u spp, the others %u\n",
+                     100.0 * double(reached) / (double(film.width()) * film.height()), most, spp_done);
+    }
+    if (stopped_by_limit && film.total_samples() == 0) {
+        std::fprintf(stderr, "candela: the time limit ended the render before any tile finished: nothing written (%s "
+                             "left as it was)\n", opt.out.c_str());
+        return 1;
+    }
     if (checkpointing && whole_passes) save("final");
 
     Image img{film.width(), film.height(), film.resolve()};
+    std::string written = opt.out;
+    bool png_failed = false;
     if (!aovs.empty() && ext == ".exr") {
         std::vector<std::string> names = aov_channel_names(aovs);
         std::vector<std::vector<float>> planes = film.resolve_aovs();
         std::vector<ExrLayer> layers;
         for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
         write_exr_layers(opt.out, img, layers);
+    } else if (ext == ".png") {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
+        // The PNG goes through GL; if that fails the samples must not go with it.
+        try {
+            write_png_headless(opt.out, img, opt.display);
+        } catch (const std::exception& e) {
+            png_failed = true;
+            written = std::filesystem::path(opt.out).replace_extension(".exr").string();
+            std::fprintf(stderr, "candela: %s\n", e.what());
+            write_linear_image(written, img);
+            std::fprintf(stderr, "candela: %s not written; the image is in %s (linear EXR) instead\n",
+                         opt.out.c_str(), written.c_str());
+        }
     } else {
         if (!aovs.empty() && !opt.quiet)
             std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
                          opt.out.c_str());
-        if (ext == ".png") write_png_headless(opt.out, img, opt.display);
-        else write_linear_image(opt.out, img);
+        write_linear_image(opt.out, img);
     }
 
     const int sig = g_signal.load();
@@ -181,16 +278,18 @@ int run_headless(const HeadlessOptions& opt) {
         std::fprintf(stderr,
                      "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",
-                     sig ? (sig == SIGTERM ? "terminated: " : "interrupted: ") : "", scene.source.c_str(), film.width(),
+                     sig ? (sig == SIGTERM ? "terminated: " : "interrupted: ") : stopped_by_limit ? "time limit: " : "",
+                     scene.source.c_str(), film.width(),
                      film.height(), spp, secs, secs > 0 ? samples / secs * 1e-6 : 0.0,
                      secs > 0 ? rays / secs * 1e-6 : 0.0, threads, scene.accel->name().c_str(),
-                     (unsigned long long)film.nonfinite_count(), opt.out.c_str());
+                     (unsigned long long)film.nonfinite_count(), written.c_str());
         if (checkpointing && whole_passes)
             std::fprintf(stderr, "candela: checkpoint %s at %u spp\n", opt.checkpoint.c_str(), spp_done);
         else if (checkpointing)
             std::fprintf(stderr, "candela: checkpoint %s not updated (stopped inside a pass; it keeps the last save)\n",
                          opt.checkpoint.c_str());
     }
+    if (png_failed) return 1;  // the file asked for is missing: a failure, even with the EXR beside it
     return sig ? 128 + sig : 0;
 }
 

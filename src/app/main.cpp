@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
 
         bool has_display = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
+        std::string why_headless = has_display ? "built without the viewer" : "no display";
 #ifdef CANDELA_HAS_VIEWER
         if (opt.out.empty() && (has_display || *shot)) {
             if (*ck_opt || *resume_opt) throw Error("--checkpoint and --resume are for headless renders: give --out");
@@ -100,7 +101,13 @@ int main(int argc, char** argv) {
             vo.screenshot = shot_args.second;
             if (*prio_opt) vo.render_priority = parse_render_priority(priority);
             if (*shot && vo.screenshot_after < 1) throw Error("--screenshot-after expects N >= 1 passes");
-            return run_viewer(vo);
+            try {
+                return run_viewer(vo);
+            } catch (const DisplayUnavailable& e) {
+                if (*shot) throw;  // a screenshot of the window needs the window
+                // DISPLAY is set but unusable (no server, a refused connection, no GL): as with none.
+                why_headless = std::string("cannot use the display (") + e.what() + ")";
+            }
         }
 #else
         (void)shot;
@@ -110,8 +117,7 @@ int main(int argc, char** argv) {
         if (opt.out.empty()) {
             opt.out = "candela.png";
             if (!opt.quiet)
-                std::fprintf(stderr, "candela: %s; rendering headless to %s\n",
-                             has_display ? "built without the viewer" : "no display", opt.out.c_str());
+                std::fprintf(stderr, "candela: %s; rendering headless to %s\n", why_headless.c_str(), opt.out.c_str());
         }
         return run_headless(opt);
     } catch (const Error& e) {

@@ -2,6 +2,10 @@
 
 #include <GL/osmesa.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
 // The one stb_image_write implementation of the whole program lives here: do not define
 // STB_IMAGE_WRITE_IMPLEMENTATION in any other file (include <stb/stb_image_write.h> and link
 // candela_display instead).
@@ -15,6 +19,10 @@
 namespace candela {
 
 HeadlessGlContext::HeadlessGlContext() {
+    // A test hook (documented in docs/reliability.md): the fallback of a failed PNG is tested
+    // without breaking Mesa.
+    if (std::getenv("CANDELA_TEST_FAIL_GL"))
+        throw Error("OSMesa: cannot create an OpenGL context (CANDELA_TEST_FAIL_GL is set)");
     // Core profile 3.3: the display shaders are GLSL 330 core. llvmpipe answers with 4.5.
     const int attribs[] = {OSMESA_FORMAT,                OSMESA_RGBA,
                            OSMESA_DEPTH_BITS,            0,
@@ -58,16 +66,45 @@ std::string HeadlessGlContext::description() const {
     return str(GL_RENDERER) + ", " + str(GL_VERSION);
 }
 
-std::vector<unsigned char> display_to_srgb8(const Image& img, const DisplaySettings& ds) {
+std::vector<unsigned char> display_to_srgb8(const Image& img, const DisplaySettings& ds, int max_tile) {
     if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * size_t(img.height) * 3)
         throw Error("display: bad image (" + std::to_string(img.width) + "x" + std::to_string(img.height) +
                     ", " + std::to_string(img.rgb.size()) + " floats)");
     // A fresh context per call: OSMesa contexts must not be shared between threads, and PNG
     // output is rare enough that the setup cost (a few ms on llvmpipe) does not matter.
     HeadlessGlContext context;
-    DisplayProgram program(context.gl());
-    program.upload(img);
-    return program.read_srgb8(ds);
+    const GlApi& gl = context.gl();
+    DisplayProgram program(gl);
+    // Tiles no larger than the texture and viewport limits (16384 on llvmpipe), so that any image
+    // the film allows gets its PNG. Each pixel's byte depends only on its own texel (nearest, at
+    // the image's own size), so the tiles assemble into exactly the untiled result.
+    GLint max_texture = 0, max_viewport[2] = {0, 0};
+    gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+    gl.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+    int tile = std::min({int(max_texture), int(max_viewport[0]), int(max_viewport[1])});
+    if (max_tile > 0) tile = std::min(tile, max_tile);
+    if (tile <= 0) throw Error("display: GL reports no texture or viewport size");
+    if (img.width <= tile && img.height <= tile) {
+        program.upload(img);
+        return program.read_srgb8(ds);
+    }
+    std::vector<unsigned char> out(size_t(img.width) * size_t(img.height) * 4);
+    std::vector<float> part;
+    for (int y0 = 0; y0 < img.height; y0 += tile)
+        for (int x0 = 0; x0 < img.width; x0 += tile) {
+            const int tw = std::min(tile, img.width - x0), th = std::min(tile, img.height - y0);
+            part.resize(size_t(tw) * size_t(th) * 3);
+            for (int y = 0; y < th; ++y)
+                std::memcpy(part.data() + size_t(y) * size_t(tw) * 3,
+                            img.rgb.data() + (size_t(y0 + y) * size_t(img.width) + size_t(x0)) * 3,
+                            size_t(tw) * 3 * sizeof(float));
+            program.upload(tw, th, part.data());
+            const std::vector<unsigned char> rgba = program.read_srgb8(ds);
+            for (int y = 0; y < th; ++y)
+                std::memcpy(out.data() + (size_t(y0 + y) * size_t(img.width) + size_t(x0)) * 4,
+                            rgba.data() + size_t(y) * size_t(tw) * 4, size_t(tw) * 4);
+        }
+    return out;
 }
 
 namespace {

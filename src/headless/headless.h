@@ -10,9 +10,12 @@ namespace candela {
 struct GlApi;
 
 // Renders the linear image through the display shaders in an off-screen OSMesa GL 3.3+ core
-// context and returns 8-bit sRGB RGBA pixels, top row first. Needs no DISPLAY. Throws Error when
-// OSMesa or the shaders fail (with the GL info log).
-std::vector<unsigned char> display_to_srgb8(const Image& img, const DisplaySettings& ds);
+// context and returns 8-bit sRGB RGBA pixels, top row first. Needs no DISPLAY. Images larger
+// than GL's texture or viewport limit are drawn in tiles (at most `max_tile` pixels a side when
+// > 0, for tests) and assembled on the CPU: the bytes equal those of one untiled draw. Throws
+// Error when OSMesa or the shaders fail (with the GL info log), or when CANDELA_TEST_FAIL_GL is
+// set in the environment (a test hook).
+std::vector<unsigned char> display_to_srgb8(const Image& img, const DisplaySettings& ds, int max_tile = 0);
 
 // display_to_srgb8, then an atomic PNG write (stb_image_write).
 void write_png_headless(const std::string& path, const Image& img, const DisplaySettings& ds);

@@ -6,6 +6,7 @@
 // reports problems with their line; tinyobjloader only ever sees files that passed.
 #include "scene/obj.h"
 #include <tiny_obj_loader.h>
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <unordered_map>
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "scene/loaders.h"
 
 namespace candela {
@@ -27,10 +29,19 @@ std::string read_text_file(const std::string& path) {
     if (std::filesystem::is_directory(path, ec)) throw Error(path, 0, "is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
+    // In chunks, so that an interrupt is noticed while a big file is read.
+    std::string text;
+    const size_t chunk = size_t(1) << 22;
+    for (;;) {
+        throw_if_interrupted();
+        const size_t have = text.size();
+        text.resize(have + chunk);
+        in.read(&text[have], std::streamsize(chunk));
+        text.resize(have + size_t(in.gcount()));
+        if (size_t(in.gcount()) < chunk) break;
+    }
     if (in.bad()) throw Error(path, 0, "cannot read file");
-    return ss.str();
+    return text;
 }
 
 std::string directory_of(const std::string& path) {
@@ -63,6 +74,7 @@ void validate_obj_text(const std::string& path, const std::string& text) {
         std::string line = text.substr(pos, eol - pos);
         pos = eol + 1;
         ++line_no;
+        throw_if_interrupted();
         auto fail = [&](const std::string& what) { throw Error(path, line_no, what); };
 
         for (char c : line)
@@ -157,6 +169,29 @@ public:
     }
 };
 
+// Serves a text to tinyobjloader in chunks and ends it early (EOF) once an interrupt is requested,
+// so that a multi-second parse stops within a chunk; read_obj then throws Interrupted. It also
+// spares the copy an istringstream would make.
+class InterruptibleText : public std::streambuf {
+public:
+    explicit InterruptibleText(const std::string& text) : next_(text.data()), end_(text.data() + text.size()) {}
+
+protected:
+    int_type underflow() override {
+        if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+        if (next_ == end_ || interrupt_requested()) return traits_type::eof();
+        const size_t n = std::min<size_t>(size_t(end_ - next_), size_t(1) << 16);
+        char* b = const_cast<char*>(next_);  // read-only: the get area is never written
+        setg(b, b, b + n);
+        next_ += n;
+        return traits_type::to_int_type(*gptr());
+    }
+
+private:
+    const char* next_;
+    const char* end_;
+};
+
 void add_warnings(ObjData& out, const std::string& path, const std::string& text) {
     std::istringstream in(text);
     std::string line;
@@ -180,11 +215,13 @@ ObjData read_obj(const std::string& path, bool materials) {
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> mtls;
     std::string warn, err;
-    std::istringstream in(text);
+    InterruptibleText text_buf(text);
+    std::istream in(&text_buf);
     tinyobj::MaterialFileReader file_reader(directory_of(path).empty() ? "./" : directory_of(path));
     IgnoreMaterials ignore;
     tinyobj::MaterialReader* reader = materials ? static_cast<tinyobj::MaterialReader*>(&file_reader) : &ignore;
     bool ok = tinyobj::LoadObj(&attrib, &shapes, &mtls, &warn, &err, &in, reader, /*triangulate=*/false);
+    throw_if_interrupted();  // before `ok`: an interrupted parse saw a cut text
     if (!ok) {
         std::string msg = err.empty() ? "could not parse OBJ file" : err;
         while (!msg.empty() && (msg.back() == '\n' || msg.back() == '.')) msg.pop_back();
@@ -239,6 +276,7 @@ ObjData read_obj(const std::string& path, bool materials) {
         std::map<int, size_t> group_of_material;  // this shape's groups, by material
         size_t first = 0;
         for (size_t f = 0; f < sh.mesh.num_face_vertices.size(); ++f) {
+            if (f % 4096 == 0) throw_if_interrupted();
             size_t count = sh.mesh.num_face_vertices[f];
             int mat = f < sh.mesh.material_ids.size() ? sh.mesh.material_ids[f] : -1;
             if (mat >= int(out.materials.size())) mat = -1;
@@ -265,6 +303,7 @@ ObjData read_obj(const std::string& path, bool materials) {
 std::vector<vec3> compute_vertex_normals(const std::vector<vec3>& positions, const std::vector<uvec3>& triangles) {
     std::vector<vec3> n(positions.size(), vec3(0.f));
     for (const uvec3& t : triangles) {
+        throw_if_interrupted();
         vec3 p[3] = {positions[t.x], positions[t.y], positions[t.z]};
         vec3 fn = glm::cross(p[1] - p[0], p[2] - p[0]);
         float len = glm::length(fn);
@@ -341,6 +380,7 @@ SceneDescription load_obj_scene(const std::string& path) {
     // Each group gets its own compact copy of the vertices it uses.
     std::vector<uint32_t> local(obj.positions.size(), UINT32_MAX);
     for (size_t gi = 0; gi < obj.groups.size(); ++gi) {
+        throw_if_interrupted();
         const ObjGroup& g = obj.groups[gi];
         std::vector<vec3> pos, nrm;
         std::vector<uint32_t> used;

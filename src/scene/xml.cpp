@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "scene/loaders.h"
 #include "scene/obj.h"
 #include "scene/params.h"
@@ -851,6 +852,7 @@ SceneDescription XmlLoader::load() {
 
     pugi::xml_node sensor, integrator;
     for (pugi::xml_node c : root.children()) {
+        throw_if_interrupted();  // a scene of many shapes; each OBJ polls as it is read
         if (c.type() != pugi::node_element) continue;
         std::string tag = c.name();
         if (tag == "default") {

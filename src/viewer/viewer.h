@@ -4,28 +4,28 @@
 // happens in a RenderSession; the window's thread never waits for a pass.
 #include <optional>
 #include <string>
-#include <vector>
+#include "core/error.h"
 #include "display/display.h"
 #include "render/launch.h"
 #include "render/session.h"
 
 namespace candela {
 
-// Responsiveness measurement (bench/viewer): the viewer moves the camera by itself on a schedule
-// and records how the window keeps up. Not used by the program's command line.
-struct ViewerBenchmark {
-    double duration = 10;       // seconds of measurement, after the first full-resolution pass
-    double move_every = 0.25;   // seconds between scripted camera changes (a small orbit step)
-    int moves_per_burst = 1;    // consecutive frames that each change the camera (a "drag")
-    bool paused = false;        // full passes paused: the window's own cost, previews only
-    // Results.
-    std::vector<double> frame_ms;   // per frame, from the end of the event wait to the swap: events, panel, upload, draw, swap
-    std::vector<double> frame_cpu_ms;  // the same, in CPU time of the window's thread: what the
-                                       // frame costs on an idle core (with LP_NUM_THREADS=0 the
-                                       // software rasteriser runs in this thread too)
-    std::vector<double> update_ms;  // camera change -> end of the first frame showing its image
-    std::vector<bool> frame_new_image;  // per frame: a new image was uploaded and tonemapped in it
-    int frames = 0;
+class ViewerFrontEnd;
+
+// A per-frame observer that may also drive the viewer, for tools that measure it (bench/viewer
+// moves the camera by itself and times how the window keeps up). The program passes none.
+class ViewerHooks {
+public:
+    struct Frame {
+        double start = 0, end = 0;  // seconds (steady clock): from the end of the event wait to the swap
+        double cpu_ms = 0;          // CPU time of the window's thread over the same span
+        bool new_image = false;     // a new image was uploaded and tonemapped in this frame
+    };
+    virtual ~ViewerHooks() = default;
+    virtual void started(ViewerFrontEnd&) {}                     // once, the session running
+    virtual void before_panel(ViewerFrontEnd&, double /*now*/) {}  // each frame after input: may edit
+    virtual bool after_frame(ViewerFrontEnd&, const Frame&) { return true; }  // false: close
 };
 
 struct ViewerOptions {
@@ -39,11 +39,19 @@ struct ViewerOptions {
     // Render threads' priority; unset: Idle for an interactive window (the window first), Normal
     // for --screenshot-after runs, where nobody is waiting on the window's frames.
     std::optional<RenderPriority> render_priority;
-    ViewerBenchmark* benchmark = nullptr;
+    ViewerHooks* hooks = nullptr;  // measuring tools only; frames are then paced without vsync
+};
+
+// Thrown by run_viewer when GLFW cannot initialise (no display server, a refused connection) or
+// cannot open a GL 3.3 window, before anything was rendered: the caller may render headless.
+class DisplayUnavailable : public Error {
+public:
+    using Error::Error;
 };
 
 // Opens the window and runs until it is closed (or the screenshot is written). Returns the process
-// exit code. Throws Error when the scene cannot be loaded or no window can be opened.
+// exit code. Throws Error when the scene cannot be loaded, DisplayUnavailable when no window can
+// be opened.
 int run_viewer(const ViewerOptions& opt);
 
 }  // namespace candela

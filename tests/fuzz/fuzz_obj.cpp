@@ -1,5 +1,5 @@
 // libFuzzer target: the OBJ path, both ways it is reached: a plain OBJ+MTL scene (materials,
-// emitters, default camera, finalize) and the geometry-only read that the XML `obj` shape uses.
+// emitters, default camera, build_scene) and the geometry-only read that the XML `obj` shape uses.
 // Any input must load or throw candela::Error; anything else is a finding.
 #include <cstdint>
 #include "core/error.h"
@@ -10,8 +10,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string path = candela::fuzz::write_input("scene.obj", data, size);
     try {
-        candela::Scene scene = candela::load_obj_scene(path);
-        scene.finalize();
+        candela::build_scene(candela::load_obj_scene(path));
     } catch (const candela::Error&) {
     }
     try {

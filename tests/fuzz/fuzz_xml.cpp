@@ -1,4 +1,4 @@
-// libFuzzer target: the Mitsuba XML scene loader, then finalize (geometry checks, accelerator and
+// libFuzzer target: the Mitsuba XML scene loader, then build_scene (geometry checks, accelerator and
 // lights), as the program does before rendering. Any input must load or throw candela::Error; a
 // crash, a sanitizer report, another exception, a leak or a hang is a finding.
 #include <cstdint>
@@ -9,8 +9,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string path = candela::fuzz::write_input("scene.xml", data, size);
     try {
-        candela::Scene scene = candela::load_mitsuba_xml(path, {});
-        scene.finalize();
+        candela::build_scene(candela::load_mitsuba_xml(path, {}));
     } catch (const candela::Error&) {
         // the expected outcome for bad input
     }

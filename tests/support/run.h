@@ -13,8 +13,9 @@ struct RunResult {
     std::string output;  // stdout and stderr together
 };
 
-inline RunResult run_candela(const std::string& args) {
-    std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + CANDELA_BIN + " " + args + " 2>&1";
+// `env` adds variables ("NAME=value ..."), after DISPLAY and WAYLAND_DISPLAY are removed.
+inline RunResult run_candela(const std::string& args, const std::string& env = "") {
+    std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + env + " " + CANDELA_BIN + " " + args + " 2>&1";
     RunResult r;
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;

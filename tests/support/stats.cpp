@@ -1,6 +1,7 @@
 // Statistical test helpers (chi-square, z/t-tests, image block tests); see stats.h.
 #include "support/stats.h"
 
+#include <gtest/gtest.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -115,7 +116,7 @@ double beta_inc(double a, double b, double x) {
 }
 
 double chi_square_sf(double stat, double dof) {
-    if (dof <= 0) return 1.0;
+    if (!(dof > 0)) return std::numeric_limits<double>::quiet_NaN();  // no distribution: no p
     return gamma_q(0.5 * dof, 0.5 * stat);
 }
 
@@ -389,8 +390,12 @@ ChiSquareResult pooled_chi_square(const std::vector<double>& obs, const std::vec
         else if (c.o > 0) r.statistic = std::numeric_limits<double>::infinity();
     }
     if (r.dof <= 0) {
-        r.p_value = 1.0;
-        r.message = "too few cells for a chi-square test";
+        // A test without degrees of freedom tests nothing: it fails the calling test, and its p
+        // is NaN, so that neither "p >= level" nor a control's "p < level" can hold.
+        r.p_value = std::numeric_limits<double>::quiet_NaN();
+        r.message = "too few cells for a chi-square test (" + std::to_string(kept.size()) + " after pooling, " +
+                    std::to_string(constraints) + " constraints): choose a finer binning or more samples";
+        ADD_FAILURE() << "chi-square test with " << r.dof << " degrees of freedom: " << r.message;
     } else {
         r.p_value = chi_square_sf(r.statistic, r.dof);
     }

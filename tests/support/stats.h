@@ -35,7 +35,8 @@ double gamma_q(double a, double x);
 // Regularised incomplete beta function I_x(a, b).
 double beta_inc(double a, double b, double x);
 
-// Survival function of the chi-square distribution: P(X >= stat) for `dof` degrees of freedom.
+// Survival function of the chi-square distribution: P(X >= stat) for `dof` degrees of freedom
+// (NaN for dof <= 0).
 double chi_square_sf(double stat, double dof);
 // Two-sided p-values of a standard normal z and of a Student t with `dof` degrees of freedom.
 double normal_two_sided_p(double z);
@@ -135,6 +136,10 @@ struct ChiSquareResult {
     std::vector<double> observed, expected;
 };
 
+// Both chi-square functions need at least one degree of freedom after pooling: with none (e.g.
+// every cell pooled into one) they record a GoogleTest failure in the calling test and return
+// p = NaN, which passes no comparison, instead of a p = 1 that would pass any test.
+//
 // Draws setup.samples samples, bins them on the grid and compares with the expected counts
 // N * integral of pdf * jacobian over each cell (Gauss-Legendre rule per cell). Cells with expected
 // count < min_expected are pooled, smallest first, into groups that reach it. A sample in a cell

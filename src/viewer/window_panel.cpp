@@ -1,0 +1,203 @@
+// The panel: render control and statistics, integrator, camera and display, materials, lights,
+// and what is under a clicked pixel.
+#include <imgui.h>
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+#include "viewer/panel.h"
+#include "viewer/window.h"
+
+namespace candela {
+
+namespace {
+
+// Resamples the convergence history onto `n` points uniform in time (the value in force at each
+// time), so that the plot's x axis is time, not pass index. log10, for a curve that falls ~1/sqrt(t).
+std::vector<float> resample_log(const std::vector<float>& v, const std::vector<float>& t, int n) {
+    std::vector<float> out;
+    if (v.empty()) return out;
+    float t0 = t.front(), t1 = std::max(t.back(), t0 + 1e-6f);
+    size_t j = 0;
+    for (int i = 0; i < n; ++i) {
+        float ti = t0 + (t1 - t0) * float(i) / float(n - 1);
+        while (j + 1 < t.size() && t[j + 1] <= ti) ++j;
+        out.push_back(std::log10(std::max(v[j], 1e-6f)));
+    }
+    return out;
+}
+
+}  // namespace
+
+void Viewer::panel() {
+    const float win_w = float(fb_w_) / fb_scale_, win_h = float(fb_h_) / fb_scale_;
+    ImGui::SetNextWindowPos(ImVec2(win_w - std::min(kPanelWidth, win_w), 0.f), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(std::min(kPanelWidth, win_w), win_h), ImGuiCond_Always);
+    ImGui::Begin("candela", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                                         ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoSavedSettings);
+    ImGui::PushItemWidth(-110.f);
+    const SessionStats& stats = fe_->stats();
+    ImGui::TextUnformatted(fe_->scene().source.c_str());
+    ImGui::TextDisabled("%dx%d, %zu triangles, %zu lights", fe_->params().settings.width, fe_->params().settings.height,
+                        fe_->scene().mesh.triangle_count(), fe_->params().emitters.size());
+    if (!fe_->status().empty()) {
+        if (fe_->status_is_error()) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.4f, 0.35f, 1.f));
+        ImGui::TextWrapped("%s", fe_->status().c_str());
+        if (fe_->status_is_error()) ImGui::PopStyleColor();
+    }
+    if (fe_->loading()) ImGui::TextDisabled("loading %s ...", fe_->loading_path().c_str());
+
+    // ---- render control and statistics (none of these widgets changes the image)
+    if (ImGui::CollapsingHeader("Render", ImGuiTreeNodeFlags_DefaultOpen)) {
+        bool paused = fe_->session().paused();
+        if (ImGui::Button(paused ? "Resume" : "Pause", ImVec2(80, 0))) fe_->session().set_paused(!paused);
+        ImGui::SameLine();
+        if (ImGui::Button("Reset", ImVec2(80, 0))) {
+            fe_->restart(viewer_now());
+        }
+        ImGui::SameLine();
+        const bool done = stats.idle || (opt_.screenshot_after > 0 && stats.passes >= opt_.screenshot_after);
+        ImGui::TextDisabled(paused ? "paused" : stats.preview ? "preview" : done ? "done" : "rendering");
+        ImGui::Text("%.0f spp  (%d passes)", stats.spp, stats.passes);
+        ImGui::Text("%.2f s   %.3f Msamples/s   %.3f Mrays/s", stats.elapsed, stats.msamples_per_s,
+                    stats.mrays_per_s);
+        if (stats.nonfinite > 0) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.4f, 0.35f, 1.f));
+        ImGui::Text("NaN/Inf samples: %llu", (unsigned long long)stats.nonfinite);
+        if (stats.nonfinite > 0) ImGui::PopStyleColor();
+        std::vector<float> curve = resample_log(stats.change, stats.change_time, 120);
+        char overlay[64];
+        std::snprintf(overlay, sizeof overlay, "rel. change/pass %.2e",
+                      stats.change.empty() ? 0.0 : double(stats.change.back()));
+        ImGui::PlotLines("##convergence", curve.empty() ? nullptr : curve.data(), int(curve.size()), 0, overlay, FLT_MAX,
+                         FLT_MAX, ImVec2(ImGui::GetContentRegionAvail().x, 56.f));
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Mean relative change of the image per pass, log10, over render time.\n"
+                              "Monte Carlo noise falls as 1/sqrt(spp): the curve flattens as it converges.");
+        int max_threads = int(std::max(1u, std::thread::hardware_concurrency()));
+        if (ImGui::SliderInt("threads", &threads_, 1, max_threads)) fe_->session().set_threads(threads_);
+        ImGui::InputText("##png", png_path_, sizeof png_path_);
+        ImGui::SameLine();
+        if (ImGui::Button("Save PNG")) save_png(png_path_);
+        ImGui::InputText("##exr", exr_path_, sizeof exr_path_);
+        ImGui::SameLine();
+        if (ImGui::Button("Save EXR")) fe_->save_exr(exr_path_);
+    }
+
+    // ---- what the image depends on: every change restarts the render
+    if (ImGui::CollapsingHeader("Integrator", ImGuiTreeNodeFlags_DefaultOpen)) {
+        RenderSettings& st = fe_->params().settings;
+        int mode = int(st.sampling);
+        if (ImGui::Combo("sampling", &mode, "light sampling\0BSDF sampling\0MIS\0")) {
+            st.sampling = SamplingMode(mode);
+            fe_->params_changed(viewer_now());
+        }
+        if (ImGui::InputInt("max depth", &st.max_depth)) {
+            st.max_depth = std::max(-1, st.max_depth);
+            fe_->params_changed(viewer_now());
+        }
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Scattering events per path; -1: unbounded (unbiased, ended by Russian roulette)");
+        // A finite depth drops every longer path: the image converges to a darker one. Say so
+        // where the setting is made (docs/accuracy.md measures the energy lost per depth).
+        if (st.max_depth >= 0) ImGui::TextColored(ImVec4(1.f, 0.75f, 0.3f, 1.f), "biased: paths longer than %d are dropped", st.max_depth);
+        if (ImGui::InputInt("RR depth", &st.rr_depth)) {
+            st.rr_depth = std::max(0, st.rr_depth);
+            fe_->params_changed(viewer_now());
+        }
+        ImGui::Text("path tracer, accelerator: %s", fe_->scene().accel ? fe_->scene().accel->name().c_str() : "-");
+    }
+
+    if (ImGui::CollapsingHeader("Camera & display", ImGuiTreeNodeFlags_DefaultOpen)) {
+        float fov = fe_->camera().fov();
+        if (ImGui::SliderFloat("fov (deg)", &fov, 5.f, 150.f, "%.1f")) {
+            fe_->camera().set_fov(fov);
+            fe_->camera_changed(viewer_now());
+        }
+        if (ImGui::Button("Reset camera")) {
+            fe_->reset_camera(viewer_now());
+        }
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Left drag: orbit   right/middle drag: pan   wheel: dolly\n"
+                              "W A S D Q E: fly (shift: faster)   click: inspect a pixel");
+        // Exposure is applied by the display shader: it changes nothing that the film holds.
+        ImGui::SliderFloat("exposure", &display_.exposure, -10.f, 10.f, "%.2f stops");
+    }
+
+    if (ImGui::CollapsingHeader("Materials", ImGuiTreeNodeFlags_DefaultOpen)) {
+        for (size_t i = 0; i < fe_->params().materials.size(); ++i) {
+            Material& m = fe_->params().materials[i];
+            ImGui::PushID(int(i));
+            const bool selected = int(i) == fe_->selected_material;
+            if (selected && fe_->reveal_selected) ImGui::SetNextItemOpen(true);
+            else if (i == 0) ImGui::SetNextItemOpen(true, ImGuiCond_Once);  // show what editing looks like
+            ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | (selected ? ImGuiTreeNodeFlags_Selected : 0);
+            bool open = ImGui::TreeNodeEx("##m", flags, "%s  (%s)", m.name.empty() ? "(unnamed)" : m.name.c_str(),
+                                          bsdf_type_name(m.bsdf));
+            if (ImGui::IsItemClicked()) fe_->selected_material = int(i);
+            if (selected && fe_->reveal_selected) {
+                ImGui::SetScrollHereY();
+                fe_->reveal_selected = false;
+            }
+            if (open) {
+                if (edit_material(m)) fe_->params_changed(viewer_now());
+                ImGui::TreePop();
+            }
+            ImGui::PopID();
+        }
+    }
+
+    if (!fe_->params().emitters.empty() && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
+        for (size_t i = 0; i < fe_->params().emitters.size(); ++i) {
+            ImGui::PushID(int(i) + 100000);
+            std::string label = "light " + std::to_string(i);
+            for (const Shape& s : fe_->scene().shapes)
+                if (s.emitter == int32_t(i)) {
+                    label += " (" + s.name + ")";
+                    break;
+                }
+            ImGui::TextUnformatted(label.c_str());
+            if (edit_emitter(fe_->params().emitters[i])) fe_->params_changed(viewer_now());
+            ImGui::PopID();
+        }
+    }
+
+    if (ImGui::CollapsingHeader("Pixel", ImGuiTreeNodeFlags_DefaultOpen)) panel_pick();
+    ImGui::TextDisabled("Drop an .obj or .xml file here to open it.");
+    ImGui::PopItemWidth();
+    ImGui::End();
+}
+
+void Viewer::panel_pick() {
+    if (!fe_->has_pick()) {
+        ImGui::TextDisabled("Click the image to inspect a pixel.");
+        return;
+    }
+    const PickResult& pick = fe_->pick_result();
+    ImGui::Text("pixel (%d, %d)", fe_->pick_pixel().x, fe_->pick_pixel().y);
+    const SessionImage& img = fe_->image();
+    if (!img.preview && img.width == fe_->params().settings.width && fe_->pick_pixel().x < img.width && fe_->pick_pixel().y < img.height) {
+        size_t k = (size_t(fe_->pick_pixel().y) * size_t(img.width) + size_t(fe_->pick_pixel().x)) * 3;
+        ImGui::Text("mean  %.4g %.4g %.4g", img.rgb[k], img.rgb[k + 1], img.rgb[k + 2]);
+        ImGui::Text("samples  %d", img.passes * std::max(1, fe_->spp_per_pass()));
+    } else {
+        ImGui::TextDisabled("mean: waiting for a full pass");
+    }
+    if (!pick.hit) {
+        ImGui::TextDisabled("nothing there (background)");
+        return;
+    }
+    const Shape& shape = fe_->scene().shapes[pick.shape];
+    ImGui::Text("object  %s", shape.name.c_str());
+    if (pick.material < fe_->params().materials.size()) {
+        const Material& m = fe_->params().materials[pick.material];
+        ImGui::Text("material  %s (%s)", m.name.c_str(), bsdf_type_name(m.bsdf));
+    }
+    if (pick.emitter >= 0) ImGui::Text("emits light %d", pick.emitter);
+    ImGui::Text("position  %.4g %.4g %.4g", pick.position.x, pick.position.y, pick.position.z);
+    ImGui::Text("normal  %.3f %.3f %.3f", pick.normal.x, pick.normal.y, pick.normal.z);
+    ImGui::Text("distance  %.4g", pick.distance);
+}
+
+
+}  // namespace candela

@@ -1,0 +1,318 @@
+// Textures against Mitsuba 3: the values its `bitmap` (every filter, wrap mode and raw setting, on an
+// RGB and a grey PNG) and `checkerboard` return at the same uv points, as printed by
+// tests/data/make_texture_reference.py. Bad image files are clean errors.
+#include <gtest/gtest.h>
+#include <cstring>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include "core/error.h"
+#include "support/run.h"
+#include "texture/texture.h"
+
+using namespace candela;
+
+namespace {
+
+struct BitmapCase {
+    const char* file;
+    const char* filter;
+    const char* wrap;
+    bool raw;
+    float u, v, r, g, b;
+};
+
+// file, filter, wrap, raw, u, v, r, g, b  (Mitsuba 3.9.1, scalar_rgb)
+const BitmapCase kBitmap[] = {
+    {"rgb3x2.png", "bilinear", "repeat", false, 0.1f, 0.2f, 0.0157311019f, 0.425375491f, 0.189390272f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 0.5f, 0.5f, 0.977986634f, 0.500758827f, 0.607930183f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 0.9f, 0.85f, 0.146475226f, 0.040550407f, 0.161879197f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 1.3f, -0.2f, 0.3984209f, 0.394715428f, 0.369413257f},
+    {"rgb3x2.png", "bilinear", "repeat", false, -0.45f, 1.7f, 0.876167834f, 0.767847955f, 0.798634887f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 2.05f, 0.55f, 0.0532976352f, 0.160381854f, 0.143821925f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 0.0f, 0.0f, 0.0675412789f, 0.160823509f, 0.253776938f},
+    {"rgb3x2.png", "bilinear", "repeat", false, 0.999f, 0.001f, 0.0677748695f, 0.160666853f, 0.256277382f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 0.1f, 0.2f, 0.0834509805f, 0.612392187f, 0.265254885f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 0.5f, 0.5f, 0.990196109f, 0.509803951f, 0.750980377f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 0.9f, 0.85f, 0.362980455f, 0.15184316f, 0.18227458f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 1.3f, -0.2f, 0.401568502f, 0.407843024f, 0.387137115f},
+    {"rgb3x2.png", "bilinear", "repeat", true, -0.45f, 1.7f, 0.919862688f, 0.78737253f, 0.826372445f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 2.05f, 0.55f, 0.150745258f, 0.265411735f, 0.176353082f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 0.0f, 0.0f, 0.198039234f, 0.290196121f, 0.286274523f},
+    {"rgb3x2.png", "bilinear", "repeat", true, 0.999f, 0.001f, 0.198896319f, 0.29049015f, 0.288734555f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 0.1f, 0.2f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 0.5f, 0.5f, 0.977986634f, 0.500758827f, 0.607930183f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 0.9f, 0.85f, 0.215860412f, 0.0144438688f, 0.00212468905f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 1.3f, -0.2f, 0.413150847f, 0.0313687287f, 0.686344266f},
+    {"rgb3x2.png", "bilinear", "mirror", false, -0.45f, 1.7f, 0.816729248f, 0.164134368f, 0.251885831f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 2.05f, 0.55f, 0.00121410796f, 0.231032297f, 0.00519322371f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 0.0f, 0.0f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "bilinear", "mirror", false, 0.999f, 0.001f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 0.1f, 0.2f, 0.0392156877f, 0.784313798f, 0.117647059f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 0.5f, 0.5f, 0.990196109f, 0.509803951f, 0.750980377f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 0.9f, 0.85f, 0.501960814f, 0.125490203f, 0.0274509806f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 1.3f, -0.2f, 0.542745054f, 0.158431411f, 0.800784409f},
+    {"rgb3x2.png", "bilinear", "mirror", true, -0.45f, 1.7f, 0.840294063f, 0.205882356f, 0.484882295f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 2.05f, 0.55f, 0.0156862754f, 0.313725501f, 0.0470588244f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 0.0f, 0.0f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "bilinear", "mirror", true, 0.999f, 0.001f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 0.1f, 0.2f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 0.5f, 0.5f, 0.977986634f, 0.500758827f, 0.607930183f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 0.9f, 0.85f, 0.215860412f, 0.0144438688f, 0.00212468905f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 1.3f, -0.2f, 0.0512694456f, 0.0512694456f, 1.0f},
+    {"rgb3x2.png", "bilinear", "clamp", false, -0.45f, 1.7f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 2.05f, 0.55f, 0.150024027f, 0.0291740987f, 0.40127477f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 0.0f, 0.0f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "bilinear", "clamp", false, 0.999f, 0.001f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 0.1f, 0.2f, 0.0392156877f, 0.784313798f, 0.117647059f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 0.5f, 0.5f, 0.990196109f, 0.509803951f, 0.750980377f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 0.9f, 0.85f, 0.501960814f, 0.125490203f, 0.0274509806f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 1.3f, -0.2f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "bilinear", "clamp", true, -0.45f, 1.7f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 2.05f, 0.55f, 0.401568651f, 0.175686285f, 0.416470587f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 0.0f, 0.0f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "bilinear", "clamp", true, 0.999f, 0.001f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", false, 0.1f, 0.2f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "repeat", false, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", false, 0.9f, 0.85f, 0.215860412f, 0.0144438697f, 0.00212468905f},
+    {"rgb3x2.png", "nearest", "repeat", false, 1.3f, -0.2f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "repeat", false, -0.45f, 1.7f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", false, 2.05f, 0.55f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "repeat", false, 0.0f, 0.0f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "repeat", false, 0.999f, 0.001f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", true, 0.1f, 0.2f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "repeat", true, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", true, 0.9f, 0.85f, 0.501960814f, 0.125490203f, 0.0274509825f},
+    {"rgb3x2.png", "nearest", "repeat", true, 1.3f, -0.2f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "repeat", true, -0.45f, 1.7f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "repeat", true, 2.05f, 0.55f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "repeat", true, 0.0f, 0.0f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "repeat", true, 0.999f, 0.001f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", false, 0.1f, 0.2f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "mirror", false, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", false, 0.9f, 0.85f, 0.215860412f, 0.0144438697f, 0.00212468905f},
+    {"rgb3x2.png", "nearest", "mirror", false, 1.3f, -0.2f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", false, -0.45f, 1.7f, 0.955973268f, 0.00151763496f, 0.215860412f},
+    {"rgb3x2.png", "nearest", "mirror", false, 2.05f, 0.55f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "mirror", false, 0.0f, 0.0f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "mirror", false, 0.999f, 0.001f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", true, 0.1f, 0.2f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "mirror", true, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", true, 0.9f, 0.85f, 0.501960814f, 0.125490203f, 0.0274509825f},
+    {"rgb3x2.png", "nearest", "mirror", true, 1.3f, -0.2f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "nearest", "mirror", true, -0.45f, 1.7f, 0.980392218f, 0.0196078438f, 0.501960814f},
+    {"rgb3x2.png", "nearest", "mirror", true, 2.05f, 0.55f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "mirror", true, 0.0f, 0.0f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "mirror", true, 0.999f, 0.001f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", false, 0.1f, 0.2f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "clamp", false, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", false, 0.9f, 0.85f, 0.215860412f, 0.0144438697f, 0.00212468905f},
+    {"rgb3x2.png", "nearest", "clamp", false, 1.3f, -0.2f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", false, -0.45f, 1.7f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "clamp", false, 2.05f, 0.55f, 0.215860412f, 0.0144438697f, 0.00212468905f},
+    {"rgb3x2.png", "nearest", "clamp", false, 0.0f, 0.0f, 0.00303526991f, 0.57758075f, 0.0129830595f},
+    {"rgb3x2.png", "nearest", "clamp", false, 0.999f, 0.001f, 0.0512694418f, 0.0512694418f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", true, 0.1f, 0.2f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "clamp", true, 0.5f, 0.5f, 1.0f, 1.0f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", true, 0.9f, 0.85f, 0.501960814f, 0.125490203f, 0.0274509825f},
+    {"rgb3x2.png", "nearest", "clamp", true, 1.3f, -0.2f, 0.250980407f, 0.250980407f, 1.0f},
+    {"rgb3x2.png", "nearest", "clamp", true, -0.45f, 1.7f, 0.0f, 0.0f, 0.0f},
+    {"rgb3x2.png", "nearest", "clamp", true, 2.05f, 0.55f, 0.501960814f, 0.125490203f, 0.0274509825f},
+    {"rgb3x2.png", "nearest", "clamp", true, 0.0f, 0.0f, 0.0392156877f, 0.784313798f, 0.117647067f},
+    {"rgb3x2.png", "nearest", "clamp", true, 0.999f, 0.001f, 0.250980407f, 0.250980407f, 1.0f},
+    {"grey2x2.png", "bilinear", "repeat", false, 0.1f, 0.2f, 0.21534729f, 0.21534729f, 0.21534729f},
+    {"grey2x2.png", "bilinear", "repeat", false, 0.5f, 0.5f, 0.294115841f, 0.294115841f, 0.294115841f},
+    {"grey2x2.png", "bilinear", "repeat", false, 0.9f, 0.85f, 0.32201311f, 0.32201311f, 0.32201311f},
+    {"grey2x2.png", "bilinear", "repeat", false, 1.3f, -0.2f, 0.122240297f, 0.122240297f, 0.122240297f},
+    {"grey2x2.png", "bilinear", "repeat", false, -0.45f, 1.7f, 0.269856036f, 0.269856036f, 0.269856036f},
+    {"grey2x2.png", "bilinear", "repeat", false, 2.05f, 0.55f, 0.237364769f, 0.237364769f, 0.237364769f},
+    {"grey2x2.png", "bilinear", "repeat", false, 0.0f, 0.0f, 0.294115841f, 0.294115841f, 0.294115841f},
+    {"grey2x2.png", "bilinear", "repeat", false, 0.999f, 0.001f, 0.295344561f, 0.295344561f, 0.295344561f},
+    {"grey2x2.png", "bilinear", "repeat", true, 0.1f, 0.2f, 0.325882405f, 0.325882405f, 0.325882405f},
+    {"grey2x2.png", "bilinear", "repeat", true, 0.5f, 0.5f, 0.480392158f, 0.480392158f, 0.480392158f},
+    {"grey2x2.png", "bilinear", "repeat", true, 0.9f, 0.85f, 0.561568677f, 0.561568677f, 0.561568677f},
+    {"grey2x2.png", "bilinear", "repeat", true, 1.3f, -0.2f, 0.3580392f, 0.3580392f, 0.3580392f},
+    {"grey2x2.png", "bilinear", "repeat", true, -0.45f, 1.7f, 0.520784318f, 0.520784318f, 0.520784318f},
+    {"grey2x2.png", "bilinear", "repeat", true, 2.05f, 0.55f, 0.434509844f, 0.434509844f, 0.434509844f},
+    {"grey2x2.png", "bilinear", "repeat", true, 0.0f, 0.0f, 0.480392188f, 0.480392188f, 0.480392188f},
+    {"grey2x2.png", "bilinear", "repeat", true, 0.999f, 0.001f, 0.481413841f, 0.481413841f, 0.481413841f},
+    {"grey2x2.png", "bilinear", "mirror", false, 0.1f, 0.2f, 0.00699539948f, 0.00699539948f, 0.00699539948f},
+    {"grey2x2.png", "bilinear", "mirror", false, 0.5f, 0.5f, 0.294115841f, 0.294115841f, 0.294115841f},
+    {"grey2x2.png", "bilinear", "mirror", false, 0.9f, 0.85f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "bilinear", "mirror", false, 1.3f, -0.2f, 0.644823909f, 0.644823909f, 0.644823909f},
+    {"grey2x2.png", "bilinear", "mirror", false, -0.45f, 1.7f, 0.281623006f, 0.281623006f, 0.281623006f},
+    {"grey2x2.png", "bilinear", "mirror", false, 2.05f, 0.55f, 0.0641432479f, 0.0641432479f, 0.0641432479f},
+    {"grey2x2.png", "bilinear", "mirror", false, 0.0f, 0.0f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "bilinear", "mirror", false, 0.999f, 0.001f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "bilinear", "mirror", true, 0.1f, 0.2f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "bilinear", "mirror", true, 0.5f, 0.5f, 0.480392158f, 0.480392158f, 0.480392158f},
+    {"grey2x2.png", "bilinear", "mirror", true, 0.9f, 0.85f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "bilinear", "mirror", true, 1.3f, -0.2f, 0.784313858f, 0.784313858f, 0.784313858f},
+    {"grey2x2.png", "bilinear", "mirror", true, -0.45f, 1.7f, 0.399215698f, 0.399215698f, 0.399215698f},
+    {"grey2x2.png", "bilinear", "mirror", true, 2.05f, 0.55f, 0.24313727f, 0.24313727f, 0.24313727f},
+    {"grey2x2.png", "bilinear", "mirror", true, 0.0f, 0.0f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "bilinear", "mirror", true, 0.999f, 0.001f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "bilinear", "clamp", false, 0.1f, 0.2f, 0.00699539948f, 0.00699539948f, 0.00699539948f},
+    {"grey2x2.png", "bilinear", "clamp", false, 0.5f, 0.5f, 0.294115841f, 0.294115841f, 0.294115841f},
+    {"grey2x2.png", "bilinear", "clamp", false, 0.9f, 0.85f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "bilinear", "clamp", false, 1.3f, -0.2f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "bilinear", "clamp", false, -0.45f, 1.7f, 0.102241814f, 0.102241814f, 0.102241814f},
+    {"grey2x2.png", "bilinear", "clamp", false, 2.05f, 0.55f, 0.497196943f, 0.497196943f, 0.497196943f},
+    {"grey2x2.png", "bilinear", "clamp", false, 0.0f, 0.0f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "bilinear", "clamp", false, 0.999f, 0.001f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "bilinear", "clamp", true, 0.1f, 0.2f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "bilinear", "clamp", true, 0.5f, 0.5f, 0.480392158f, 0.480392158f, 0.480392158f},
+    {"grey2x2.png", "bilinear", "clamp", true, 0.9f, 0.85f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "bilinear", "clamp", true, 1.3f, -0.2f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "bilinear", "clamp", true, -0.45f, 1.7f, 0.352941185f, 0.352941185f, 0.352941185f},
+    {"grey2x2.png", "bilinear", "clamp", true, 2.05f, 0.55f, 0.721568644f, 0.721568644f, 0.721568644f},
+    {"grey2x2.png", "bilinear", "clamp", true, 0.0f, 0.0f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "bilinear", "clamp", true, 0.999f, 0.001f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "nearest", "repeat", false, 0.1f, 0.2f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "repeat", false, 0.5f, 0.5f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "repeat", false, 0.9f, 0.85f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "repeat", false, 1.3f, -0.2f, 0.102241814f, 0.102241814f, 0.102241814f},
+    {"grey2x2.png", "nearest", "repeat", false, -0.45f, 1.7f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "repeat", false, 2.05f, 0.55f, 0.102241814f, 0.102241814f, 0.102241814f},
+    {"grey2x2.png", "nearest", "repeat", false, 0.0f, 0.0f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "repeat", false, 0.999f, 0.001f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "nearest", "repeat", true, 0.1f, 0.2f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "repeat", true, 0.5f, 0.5f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "repeat", true, 0.9f, 0.85f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "repeat", true, 1.3f, -0.2f, 0.352941185f, 0.352941185f, 0.352941185f},
+    {"grey2x2.png", "nearest", "repeat", true, -0.45f, 1.7f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "repeat", true, 2.05f, 0.55f, 0.352941185f, 0.352941185f, 0.352941185f},
+    {"grey2x2.png", "nearest", "repeat", true, 0.0f, 0.0f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "repeat", true, 0.999f, 0.001f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "nearest", "mirror", false, 0.1f, 0.2f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "mirror", false, 0.5f, 0.5f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "mirror", false, 0.9f, 0.85f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "mirror", false, 1.3f, -0.2f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "nearest", "mirror", false, -0.45f, 1.7f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "mirror", false, 2.05f, 0.55f, 0.102241814f, 0.102241814f, 0.102241814f},
+    {"grey2x2.png", "nearest", "mirror", false, 0.0f, 0.0f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "mirror", false, 0.999f, 0.001f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "nearest", "mirror", true, 0.1f, 0.2f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "mirror", true, 0.5f, 0.5f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "mirror", true, 0.9f, 0.85f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "mirror", true, 1.3f, -0.2f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "nearest", "mirror", true, -0.45f, 1.7f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "mirror", true, 2.05f, 0.55f, 0.352941185f, 0.352941185f, 0.352941185f},
+    {"grey2x2.png", "nearest", "mirror", true, 0.0f, 0.0f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "mirror", true, 0.999f, 0.001f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "nearest", "clamp", false, 0.1f, 0.2f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "clamp", false, 0.5f, 0.5f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "clamp", false, 0.9f, 0.85f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "clamp", false, 1.3f, -0.2f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "nearest", "clamp", false, -0.45f, 1.7f, 0.102241814f, 0.102241814f, 0.102241814f},
+    {"grey2x2.png", "nearest", "clamp", false, 2.05f, 0.55f, 0.351532549f, 0.351532549f, 0.351532549f},
+    {"grey2x2.png", "nearest", "clamp", false, 0.0f, 0.0f, 0.00699539902f, 0.00699539902f, 0.00699539902f},
+    {"grey2x2.png", "nearest", "clamp", false, 0.999f, 0.001f, 0.715693593f, 0.715693593f, 0.715693593f},
+    {"grey2x2.png", "nearest", "clamp", true, 0.1f, 0.2f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "clamp", true, 0.5f, 0.5f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "clamp", true, 0.9f, 0.85f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "clamp", true, 1.3f, -0.2f, 0.862745166f, 0.862745166f, 0.862745166f},
+    {"grey2x2.png", "nearest", "clamp", true, -0.45f, 1.7f, 0.352941185f, 0.352941185f, 0.352941185f},
+    {"grey2x2.png", "nearest", "clamp", true, 2.05f, 0.55f, 0.627451003f, 0.627451003f, 0.627451003f},
+    {"grey2x2.png", "nearest", "clamp", true, 0.0f, 0.0f, 0.0784313753f, 0.0784313753f, 0.0784313753f},
+    {"grey2x2.png", "nearest", "clamp", true, 0.999f, 0.001f, 0.862745166f, 0.862745166f, 0.862745166f},
+};
+
+struct CheckerCase {
+    float u, v, r, g, b;
+};
+
+// checkerboard color0 (0.9, 0.1, 0.2), color1 (0.05, 0.6, 0.3), to_uv scale 4 3 1
+const CheckerCase kChecker[] = {
+    {0.1f, 0.2f, 0.0500000007f, 0.600000024f, 0.300000012f},
+    {0.5f, 0.5f, 0.899999976f, 0.100000001f, 0.200000003f},
+    {0.9f, 0.85f, 0.899999976f, 0.100000001f, 0.200000003f},
+    {1.3f, -0.2f, 0.899999976f, 0.100000001f, 0.200000003f},
+    {-0.45f, 1.7f, 0.899999976f, 0.100000001f, 0.200000003f},
+    {2.05f, 0.55f, 0.0500000007f, 0.600000024f, 0.300000012f},
+    {0.0f, 0.0f, 0.899999976f, 0.100000001f, 0.200000003f},
+    {0.999f, 0.001f, 0.0500000007f, 0.600000024f, 0.300000012f},
+};
+
+std::string data_file(const char* name) { return std::string(CANDELA_TEST_DATA) + "/textures/" + name; }
+
+void expect_close(vec3 got, vec3 want, const std::string& what) {
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(got[c], want[c], 2e-6f + 2e-6f * std::abs(want[c])) << what << " channel " << c;
+}
+
+}  // namespace
+
+TEST(Texture, BitmapMatchesMitsuba) {
+    int n = 0;
+    for (const BitmapCase& c : kBitmap) {
+        BitmapTexture t;
+        t.texels = load_texels(data_file(c.file), c.raw);
+        t.filter = std::strcmp(c.filter, "nearest") == 0 ? TextureFilter::Nearest : TextureFilter::Bilinear;
+        t.wrap = std::strcmp(c.wrap, "mirror") == 0  ? TextureWrap::Mirror
+                 : std::strcmp(c.wrap, "clamp") == 0 ? TextureWrap::Clamp
+                                                     : TextureWrap::Repeat;
+        TextureQuery q;
+        q.uv = vec2(c.u, c.v);
+        expect_close(t.eval(q), vec3(c.r, c.g, c.b),
+                     std::string(c.file) + " " + c.filter + " " + c.wrap + (c.raw ? " raw" : "") + " at (" +
+                         std::to_string(c.u) + ", " + std::to_string(c.v) + ")");
+        ++n;
+    }
+    EXPECT_EQ(n, 2 * 2 * 3 * 2 * 8);
+}
+
+TEST(Texture, CheckerboardMatchesMitsuba) {
+    CheckerboardTexture t;
+    t.color0 = std::make_shared<Texture>(constant_texture(vec3(0.9f, 0.1f, 0.2f)));
+    t.color1 = std::make_shared<Texture>(constant_texture(vec3(0.05f, 0.6f, 0.3f)));
+    t.to_uv = UvTransform::from_mat4(glm::scale(mat4(1.f), vec3(4.f, 3.f, 1.f)));
+    for (const CheckerCase& c : kChecker) {
+        TextureQuery q;
+        q.uv = vec2(c.u, c.v);
+        expect_close(t.eval(q), vec3(c.r, c.g, c.b), "checkerboard at (" + std::to_string(c.u) + ", " + std::to_string(c.v) + ")");
+    }
+}
+
+TEST(Texture, UvTransformTakesTheAffinePartOfA4x4) {
+    mat4 m = glm::translate(mat4(1.f), vec3(0.25f, -0.5f, 7.f)) * glm::scale(mat4(1.f), vec3(2.f, 3.f, 5.f));
+    vec2 uv = UvTransform::from_mat4(m).apply(vec2(0.5f, 0.25f));
+    EXPECT_FLOAT_EQ(uv.x, 2.f * 0.5f + 0.25f);
+    EXPECT_FLOAT_EQ(uv.y, 3.f * 0.25f - 0.5f);
+}
+
+TEST(Texture, MeshAttributeReadsTheVertexColour) {
+    Texture t{MeshAttributeTexture{}};
+    TextureQuery q;
+    q.vertex_color = vec3(0.1f, 0.2f, 0.3f);
+    EXPECT_EQ(t.eval(q), q.vertex_color);
+    EXPECT_TRUE(t.uses_vertex_colors());
+    EXPECT_FALSE(constant_texture(vec3(1.f)).uses_vertex_colors());
+    EXPECT_NEAR(t.eval_1(q), luminance(q.vertex_color), 1e-7f);
+}
+
+TEST(Texture, BadImageFilesAreCleanErrors) {
+    const std::string dir = candela::test::temp_dir("texture_bad");
+    auto expect_error = [](const std::string& path, const char* what) {
+        try {
+            load_texels(path, false);
+            ADD_FAILURE() << path << " was accepted";
+        } catch (const Error& e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find(path), std::string::npos) << msg;
+            EXPECT_NE(msg.find(what), std::string::npos) << msg;
+            EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+        }
+    };
+    expect_error(dir + "/missing.png", "not found");
+    candela::test::write_text(dir + "/garbage.png", "this is not an image at all");
+    expect_error(dir + "/garbage.png", "cannot read image");
+    // A PNG whose header claims 100000 x 100000 pixels (40 GB as floats).
+    const unsigned char header[] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                    0, 0x01, 0x86, 0xa0, 0, 0x01, 0x86, 0xa0, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+    std::ofstream(dir + "/huge.png", std::ios::binary).write(reinterpret_cast<const char*>(header), sizeof header);
+    expect_error(dir + "/huge.png", "huge.png");
+    // A truncated copy of a good PNG.
+    std::string good = candela::test::read_bytes(data_file("rgb3x2.png"));
+    candela::test::write_text(dir + "/truncated.png", good.substr(0, good.size() / 2));
+    expect_error(dir + "/truncated.png", "truncated.png");
+}
