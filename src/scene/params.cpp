@@ -14,6 +14,7 @@ const char* param_type_name(ParamType t) {
         case ParamType::Boolean: return "boolean";
         case ParamType::String: return "string";
         case ParamType::Rgb: return "rgb";
+        case ParamType::Spectrum: return "spectrum";
         case ParamType::Point: return "point";
         case ParamType::Vector: return "vector";
         case ParamType::Transform: return "transform";
@@ -82,11 +83,11 @@ Error ParamSet::error(const std::string& name, const std::string& what) const {
     return Error(file_, line_of(name), what);
 }
 
-const Param* ParamSet::fetch(const std::string& name, ParamType want, ParamType alt) const {
+const Param* ParamSet::fetch(const std::string& name, ParamType want, ParamType alt, ParamType alt2) const {
     const Param* p = find(name);
     if (!p) return nullptr;
     p->used = true;
-    if (p->type != want && p->type != alt)
+    if (p->type != want && p->type != alt && p->type != alt2)
         throw Error(file_, p->line, "parameter '" + name + "' of " + object_ + " must be <" + param_type_name(want) +
                                         ">, not <" + param_type_name(p->type) + ">");
     return p;
@@ -131,7 +132,7 @@ std::string ParamSet::get_string(const std::string& name, const std::string& def
 }
 
 vec3 ParamSet::get_rgb(const std::string& name, vec3 def) const {
-    const Param* p = fetch(name, ParamType::Rgb, ParamType::Float);
+    const Param* p = fetch(name, ParamType::Rgb, ParamType::Float, ParamType::Spectrum);
     if (!p) return def;
     std::vector<float> v;
     try {
@@ -140,7 +141,7 @@ vec3 ParamSet::get_rgb(const std::string& name, vec3 def) const {
         v.clear();
     }
     if (v.size() == 1) return vec3(v[0]);
-    if (v.size() == 3 && p->type == ParamType::Rgb) return vec3(v[0], v[1], v[2]);
+    if (v.size() == 3 && p->type != ParamType::Float) return vec3(v[0], v[1], v[2]);
     throw Error(file_, p->line, "could not parse " + std::string(param_type_name(p->type)) + " value '" + p->value +
                                     "' for parameter '" + name + "'" +
                                     (p->type == ParamType::Rgb ? " (expected 1 or 3 numbers)" : ""));

@@ -12,14 +12,15 @@
 
 namespace candela {
 
-enum class ParamType { Integer, Float, Boolean, String, Rgb, Point, Vector, Transform };
+enum class ParamType { Integer, Float, Boolean, String, Rgb, Spectrum, Point, Vector, Transform };
 
 const char* param_type_name(ParamType t);  // the XML tag: "integer", "float", ...
 
 struct Param {
     std::string name;
     ParamType type = ParamType::Float;
-    std::string value;      // attribute text after $name substitution (unused for transforms)
+    std::string value;      // attribute text after $name substitution (unused for transforms); a
+                            // <spectrum>: one number (constant) or its linear sRGB "r g b"
     mat4 transform{1.f};    // Transform only: already composed by the XML reader
     int line = 0;
     mutable bool used = false;
@@ -36,7 +37,8 @@ public:
     bool has(const std::string& name) const { return find(name) != nullptr; }
 
     // Typed getters: the default when absent, an Error when present with another type or bad text.
-    // get_float also takes an <integer> (exact); get_rgb also takes a <float> (grey).
+    // get_float also takes an <integer> (exact); get_rgb also takes a <float> (grey) and a <spectrum>
+    // (converted to linear sRGB by the XML reader).
     int get_int(const std::string& name, int def) const;
     float get_float(const std::string& name, float def) const;
     bool get_bool(const std::string& name, bool def) const;
@@ -57,7 +59,8 @@ public:
 
 private:
     const Param* find(const std::string& name) const;
-    const Param* fetch(const std::string& name, ParamType want, ParamType alt) const;
+    const Param* fetch(const std::string& name, ParamType want, ParamType alt, ParamType alt2) const;
+    const Param* fetch(const std::string& name, ParamType want, ParamType alt) const { return fetch(name, want, alt, alt); }
 
     std::string file_, object_;
     std::vector<Param> params_;

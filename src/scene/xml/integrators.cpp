@@ -1,0 +1,34 @@
+// The integrator family of the XML reader: Mitsuba 3's integrators as RenderSettings.
+#include "scene/plugins/render_factories.h"
+#include "scene/xml/plugins.h"
+
+namespace candela {
+namespace xml {
+
+// The factories themselves are in scene/plugins/render_factories.cpp (path, volpath, direct and
+// the moment and aov wrappers); this walks the wrappers' nesting.
+void load_integrator(XmlLoader& L, pugi::xml_node n) {
+    RenderSettings s = L.scene().settings;
+    for (int level = 0;; ++level) {
+        Object o = L.read_object(n, "integrator");
+        if (read_integrator(o.type, o.params, s, o.line) == IntegratorRole::Renders) {
+            L.finish(o);
+            break;
+        }
+        Nested* inner = nullptr;
+        for (Nested& c : o.nested) {
+            if (c.tag != "integrator") continue;
+            if (inner) throw L.error(c.node, o.what() + " with more than one nested integrator (candela renders one)");
+            inner = &c;
+        }
+        if (!inner) throw L.error(n, o.what() + " needs a nested <integrator>");
+        if (level >= 8) throw L.error(n, "integrators nested more than 8 deep");
+        inner->used = true;
+        L.finish(o);
+        n = inner->node;
+    }
+    L.scene().settings = s;
+}
+
+}  // namespace xml
+}  // namespace candela

@@ -1,0 +1,52 @@
+#pragma once
+// The plugin families of the XML reader (see parser.h). Each family file defines its factories,
+// its table and the entry point the parser core calls for a top-level (or nested) element of its
+// tag. Adding a plugin: write its factory in the family's file and add one row to its table.
+#include "scene/xml/parser.h"
+
+namespace candela {
+namespace xml {
+
+// ---- bsdfs.cpp: <bsdf> -> Material (the name is set by the caller) ----
+using BsdfFactory = Material (*)(XmlLoader&, Object&);
+const PluginTable<BsdfFactory>& bsdf_plugins();
+
+// ---- shapes.cpp: <shape> -> triangles in object space, then placed by the common code ----
+struct ShapeGeometry {
+    std::vector<vec3> positions, normals;  // object space; normals empty or per vertex
+    std::vector<uvec3> triangles;
+    // Mitsuba's rectangle and cube: under a mirroring to_world their geometric normal follows the
+    // transformed winding but their shading normal is to_world^-T n_local, so the two disagree
+    // (Mitsuba 3.9 checked). `normals` then become vertex normals, and are dropped otherwise.
+    bool analytic = false;
+    bool recompute_normals = false;  // obj without normals, face_normals false (Mitsuba's default)
+};
+using ShapeFactory = ShapeGeometry (*)(XmlLoader&, Object&);
+const PluginTable<ShapeFactory>& shape_plugins();
+void load_shape(XmlLoader& L, pugi::xml_node n);
+
+// ---- emitters.cpp: <emitter> nested in a shape (area), and top-level emitters ----
+using AreaEmitterFactory = AreaEmitter (*)(XmlLoader&, Object&);
+const PluginTable<AreaEmitterFactory>& area_emitter_plugins();
+// The emitter nested in a shape: its index in scene().emitters.
+int32_t load_shape_emitter(XmlLoader& L, pugi::xml_node n);
+void load_emitter(XmlLoader& L, pugi::xml_node n);  // top level
+
+// ---- sensors.cpp: <sensor> with its <film> (and <rfilter>) and <sampler> ----
+using SensorFactory = Camera (*)(XmlLoader&, Object&);
+using FilmFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
+using SamplerFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
+const PluginTable<SensorFactory>& sensor_plugins();
+const PluginTable<FilmFactory>& film_plugins();
+const PluginTable<SamplerFactory>& sampler_plugins();
+void load_sensor(XmlLoader& L, pugi::xml_node n);
+// A film's nested <rfilter> (at most one; gaussian without one), for film factories. The filter
+// factories are read_rfilter (scene/plugins/render_factories.h).
+void load_rfilters(XmlLoader& L, Object& film, RenderSettings& s);
+
+// ---- integrators.cpp: <integrator> -> RenderSettings (factories: read_integrator,
+// scene/plugins/render_factories.h; this walks the moment/aov wrappers) ----
+void load_integrator(XmlLoader& L, pugi::xml_node n);
+
+}  // namespace xml
+}  // namespace candela
