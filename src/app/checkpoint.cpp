@@ -213,6 +213,23 @@ uint64_t scene_fingerprint(const Scene& scene) {
         h.u64(s.first_triangle);
         h.u64(s.triangle_count);
     }
+    // Analytic shapes (only when there are some: a scene of triangles keeps its fingerprint).
+    if (!scene.analytic.empty()) {
+        h.str("analytic");
+        h.u64(scene.analytic.size());
+        for (const AnalyticShape& a : scene.analytic) {
+            h.u64(uint64_t(a.kind));
+            h.u64(a.shape);
+            h.u64(a.flip);
+            h.v3(a.center);
+            h.f32(a.radius);
+            h.f32(a.length);
+            h.bytes(&a.to_world, sizeof(a.to_world));
+            h.v3(a.normal);
+            h.f32(a.area);
+        }
+        for (const Shape& s : scene.shapes) h.i64(s.analytic);
+    }
     h.u64(scene.emitters.size());
     for (const AreaEmitter& e : scene.emitters) h.v3(e.radiance);
 

@@ -4,12 +4,18 @@
 
 namespace candela {
 
-// What an accelerator reports: the closest triangle and where on it. The surface point is
-// rebuilt from the barycentrics (not o + t d), which keeps its error small and bounded.
+// The kinds of primitive an accelerator reports (geometry/analytic.h for the analytic ones).
+enum class PrimKind : uint32_t { Triangle = 0, Sphere, Disk, Cylinder };
+
+// What an accelerator reports: the closest primitive and where on it. A triangle's surface point
+// is rebuilt from the barycentrics (not o + t d), which keeps its error small and bounded; an
+// analytic shape's is `local`, already refined onto the surface by its intersector.
 struct Hit {
     float t = kInfinity;
     float b1 = 0.f, b2 = 0.f;
-    uint32_t prim = ~0u;
+    uint32_t prim = ~0u;                // triangle index, or index into Geometry::analytic
+    PrimKind kind = PrimKind::Triangle;
+    vec3 local{0.f};                    // analytic shapes only (see intersect_analytic)
 };
 
 // A point on a surface with what shading needs. p_error bounds |p - exact point| per axis.
@@ -20,6 +26,8 @@ struct SurfaceInteraction {
     vec3 ns{0.f, 0.f, 1.f};  // shading normal (interpolated vertex normal, or ng)
     uint32_t prim = ~0u;
     uint32_t shape = ~0u;
+    PrimKind kind = PrimKind::Triangle;
+    vec2 uv{0.f};            // analytic shapes: Mitsuba's parameterisation (triangles: not yet)
 };
 
 // Offsets p along the normal by the point's error bound, on the side of w, then rounds away from

@@ -49,6 +49,7 @@ struct Shape {
     bool smooth = false;       // interpolate vertex normals (else the face normal shades)
     uint32_t first_triangle = 0;
     uint32_t triangle_count = 0;
+    int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder (no triangles)
 };
 
 }  // namespace candela

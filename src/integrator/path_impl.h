@@ -13,7 +13,7 @@ inline float power_heuristic(float a, float b) {
 // every further emitter, to the first surface that does not emit (Integrator::skip_area_emitters).
 // `ray` and `hit` become that continuation. Returns false when it hits nothing.
 inline bool skip_area_emitters(const Scene& sc, Ray& ray, Hit& hit, PathStats& stats) {
-    for (int i = 0; i < 1024 && sc.lights.emitter_of(hit.prim) >= 0; ++i) {
+    for (int i = 0; i < 1024 && sc.lights.emitter_of(hit) >= 0; ++i) {
         const SurfaceInteraction si = sc.interaction(hit);
         ray = spawn_ray(si, ray.d);  // unbounded, as Mitsuba's si.spawn_ray: the far clip is not kept
         hit = Hit();
@@ -44,7 +44,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         vec3 wo_world = -glm::normalize(ray.d);
 
         // Emission reached by this ray.
-        if (sc.lights.emitter_of(hit.prim) >= 0) {
+        if (sc.lights.emitter_of(hit) >= 0) {
             vec3 Le = sc.lights.emitted(si, wo_world);
             if (!is_black(Le)) {
                 if (after_delta || mode == SamplingMode::Bsdf) {

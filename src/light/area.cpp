@@ -3,8 +3,13 @@
 
 namespace candela {
 
-void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters) {
+void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters,
+                     const std::vector<AnalyticShape>* analytic) {
     mesh_ = &mesh;
+    analytic_ = analytic;
+    alights_.clear();
+    analytic_light_.clear();
+    analytic_emitter_.clear();
     tris_.clear();
     area_.clear();
     radiance_.clear();
@@ -32,6 +37,21 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
             weights.push_back(w);
         }
     }
+    // Analytic emitters after all triangles, so that the triangles' entries keep their indices.
+    for (const Shape& s : shapes) {
+        if (s.emitter < 0 || s.analytic < 0 || !analytic) continue;
+        if (analytic_emitter_.empty()) {
+            analytic_light_.assign(analytic->size(), -1);
+            analytic_emitter_.assign(analytic->size(), -1);
+        }
+        const AnalyticShape& a = (*analytic)[size_t(s.analytic)];
+        analytic_emitter_[size_t(s.analytic)] = s.emitter;
+        float w = a.area * luminance(emitters[size_t(s.emitter)].radiance);
+        if (!(w > 0.f) || !std::isfinite(w)) continue;
+        analytic_light_[size_t(s.analytic)] = int32_t(tris_.size() + alights_.size());
+        alights_.push_back(uint32_t(s.analytic));
+        weights.push_back(w);
+    }
     dist_.build(weights);
 }
 
@@ -42,9 +62,26 @@ static inline void interpolate_point(vec3 p0, vec3 p1, vec3 p2, float b0, float 
 }
 
 bool LightSet::sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const {
-    if (tris_.empty()) return false;
+    if (empty()) return false;
     float pmf;
     size_t i = dist_.sample(u1, &pmf);
+    if (i >= tris_.size()) {
+        const AnalyticShape& a = (*analytic_)[alights_[i - tris_.size()]];
+        AnalyticSample as;
+        if (!sample_analytic(a, ref_p, u2, as)) return false;
+        vec3 d = as.p - ref_p;
+        float dist2 = glm::dot(d, d);
+        if (!(dist2 > 0.f)) return false;
+        out.dist = std::sqrt(dist2);
+        out.wi = d / out.dist;
+        if (glm::dot(out.wi, as.n) >= 0.f) return false;  // we see its back (one-sided)
+        out.p = as.p;
+        out.p_error = as.p_error;
+        out.n = as.n;
+        out.Le = emitter_radiance_[size_t(analytic_emitter_[alights_[i - tris_.size()]])];
+        out.pdf = pmf * as.pdf;
+        return std::isfinite(out.pdf) && out.pdf > 0.f;
+    }
     uint32_t tri = tris_[i];
     vec3 p0, p1, p2;
     mesh_->vertices(tri, p0, p1, p2);
@@ -75,6 +112,12 @@ bool LightSet::sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const 
 }
 
 float LightSet::pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const {
+    if (on_light.kind != PrimKind::Triangle) {
+        if (analytic_light_.empty()) return 0.f;
+        int32_t li = analytic_light_[on_light.prim];
+        if (li < 0) return 0.f;
+        return dist_.pmf(size_t(li)) * pdf_analytic((*analytic_)[on_light.prim], ref_p, on_light.p, on_light.ng);
+    }
     if (prim_light_.empty()) return 0.f;
     int32_t li = prim_light_[on_light.prim];
     if (li < 0) return 0.f;
@@ -86,6 +129,11 @@ float LightSet::pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const {
 }
 
 vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
+    if (on_light.kind != PrimKind::Triangle) {
+        int32_t e = analytic_emitter_.empty() ? -1 : analytic_emitter_[on_light.prim];
+        if (e < 0 || glm::dot(w, on_light.ns) <= 0.f) return vec3(0.f);
+        return emitter_radiance_[size_t(e)];
+    }
     if (tri_emitter_.empty()) return vec3(0.f);
     int32_t e = tri_emitter_[on_light.prim];
     if (e < 0 || glm::dot(w, on_light.ns) <= 0.f) return vec3(0.f);

@@ -1,5 +1,6 @@
 #pragma once
 #include <vector>
+#include "geometry/analytic.h"
 #include "geometry/interaction.h"
 #include "geometry/mesh.h"
 #include "sampling/distribution.h"
@@ -22,14 +23,17 @@ struct LightSample {
     float pdf = 0.f;            // solid-angle density at the reference point (includes the pmf)
 };
 
-// All emissive triangles of the scene. A triangle is picked with probability proportional to
-// area x luminance(radiance), then a point uniformly on it; the area density is converted to solid
-// angle at the reference point: pdf_sa = pmf(tri) / area(tri) * dist^2 / |cos theta_light|.
+// All emissive triangles and analytic shapes of the scene. A triangle or shape is picked with
+// probability proportional to area x luminance(radiance). On a triangle the point is uniform by area
+// and the density converted to solid angle at the reference point: pdf_sa = pmf(tri) / area(tri)
+// * dist^2 / |cos theta_light|. On an analytic shape it is sample_analytic's (a sphere seen from
+// outside: uniform in the cone it subtends), times the pmf.
 class LightSet {
 public:
-    void build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters);
+    void build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters,
+               const std::vector<AnalyticShape>* analytic = nullptr);
 
-    bool empty() const { return tris_.empty(); }
+    bool empty() const { return tris_.empty() && alights_.empty(); }
     size_t triangle_count() const { return tris_.size(); }
 
     // u1 picks the triangle, u2 the point on it. Returns false where nothing can be emitted
@@ -44,13 +48,19 @@ public:
 
     // The emitter of the shape a triangle belongs to, or -1.
     int32_t emitter_of(uint32_t prim) const { return prim_light_.empty() ? -1 : tri_emitter_[prim]; }
+    // The emitter of the primitive a ray hit (a triangle or an analytic shape), or -1.
+    int32_t emitter_of(const Hit& hit) const {
+        if (hit.kind != PrimKind::Triangle) return analytic_emitter_.empty() ? -1 : analytic_emitter_[hit.prim];
+        return emitter_of(hit.prim);
+    }
 
     // Bytes held by the light tables (the per-triangle maps exist only when the scene has lights).
     size_t memory_bytes() const {
         return tris_.capacity() * sizeof(uint32_t) + area_.capacity() * sizeof(float) +
                radiance_.capacity() * sizeof(vec3) + prim_light_.capacity() * sizeof(int32_t) +
                tri_emitter_.capacity() * sizeof(int32_t) + emitter_radiance_.capacity() * sizeof(vec3) +
-               dist_.memory_bytes();
+               alights_.capacity() * sizeof(uint32_t) + analytic_light_.capacity() * sizeof(int32_t) +
+               analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes();
     }
 
 private:
@@ -61,6 +71,11 @@ private:
     std::vector<int32_t> prim_light_;     // triangle id -> index into tris_, or -1
     std::vector<int32_t> tri_emitter_;    // triangle id -> emitter index, or -1
     std::vector<vec3> emitter_radiance_;
+    // Analytic emitters: entry tris_.size() + k of dist_ is analytic shape alights_[k].
+    const std::vector<AnalyticShape>* analytic_ = nullptr;
+    std::vector<uint32_t> alights_;           // emissive analytic shape indices
+    std::vector<int32_t> analytic_light_;     // analytic index -> dist_ entry, or -1
+    std::vector<int32_t> analytic_emitter_;   // analytic index -> emitter index, or -1
     DiscreteDistribution dist_;
 };
 

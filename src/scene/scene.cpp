@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 #include "core/error.h"
+#include "accel/with_analytic.h"
 #include "film/film.h"
 
 namespace candela {
@@ -28,6 +29,20 @@ uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<
     }
     shapes.push_back(s);
     return shape_index;
+}
+
+uint32_t SceneDescription::add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material,
+                                              int32_t emitter) {
+    Shape s;
+    s.name = name;
+    s.material = material;
+    s.emitter = emitter;
+    s.first_triangle = uint32_t(mesh.triangles.size());
+    s.analytic = int32_t(analytic.size());
+    a.shape = uint32_t(shapes.size());
+    analytic.push_back(a);
+    shapes.push_back(s);
+    return a.shape;
 }
 
 namespace {
@@ -73,6 +88,7 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       geometry(std::move(geometry_)),
       mesh(geometry->mesh),
       shapes(geometry->shapes),
+      analytic(geometry->analytic),
       accel(std::move(accel_)),
       light_set(std::move(lights_)),
       lights(*light_set),
@@ -97,10 +113,16 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     auto geometry = std::make_shared<Geometry>();
     geometry->mesh = std::move(desc.mesh);
     geometry->shapes = std::move(desc.shapes);
+    geometry->analytic = std::move(desc.analytic);
     geometry->bounds = geometry->mesh.bounds();
-    std::shared_ptr<const Accel> accel = make_accel(accel_name, geometry->mesh);
+    for (const AnalyticShape& a : geometry->analytic) geometry->bounds.expand(a.bounds());
+    std::unique_ptr<Accel> tri_accel = make_accel(accel_name, geometry->mesh);
+    // Only a scene with analytic shapes pays for querying them.
+    std::shared_ptr<const Accel> accel =
+        geometry->analytic.empty() ? std::shared_ptr<const Accel>(std::move(tri_accel))
+                                   : std::make_shared<WithAnalyticAccel>(std::move(tri_accel), geometry->analytic);
     auto lights = std::make_shared<LightSet>();
-    lights->build(geometry->mesh, geometry->shapes, params.emitters);
+    lights->build(geometry->mesh, geometry->shapes, params.emitters, &geometry->analytic);
     return std::shared_ptr<const Scene>(
         new Scene(std::move(desc.source), std::move(geometry), std::move(accel), std::move(lights), params,
                   std::move(desc.warnings)));
@@ -111,13 +133,14 @@ std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     std::shared_ptr<const LightSet> lights_for = light_set;
     if (!same_emitters(emitters, p.emitters)) {
         auto rebuilt = std::make_shared<LightSet>();
-        rebuilt->build(mesh, shapes, p.emitters);
+        rebuilt->build(mesh, shapes, p.emitters, &analytic);
         lights_for = std::move(rebuilt);
     }
     return std::shared_ptr<const Scene>(new Scene(source, geometry, accel, std::move(lights_for), p, warnings));
 }
 
 SurfaceInteraction Scene::interaction(const Hit& hit) const {
+    if (__builtin_expect(hit.kind != PrimKind::Triangle, 0)) return analytic_interaction(analytic[hit.prim], hit);
     SurfaceInteraction si;
     si.prim = hit.prim;
     si.shape = mesh.tri_shape[hit.prim];

@@ -16,6 +16,7 @@
 #include "accel/accel.h"
 #include "bsdf/bsdf.h"
 #include "film/filter.h"
+#include "geometry/analytic.h"
 #include "geometry/mesh.h"
 #include "integrator/desc.h"
 #include "light/area.h"
@@ -52,6 +53,7 @@ struct SceneDescription {
     std::string source;                  // file it came from ("<built-in Cornell box>" otherwise)
     Mesh mesh;
     std::vector<Shape> shapes;
+    std::vector<AnalyticShape> analytic;  // spheres, disks, cylinders (Shape::analytic indexes it)
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
     Camera camera;
@@ -61,12 +63,15 @@ struct SceneDescription {
     // Appends a shape made of the given triangles (world space). Returns its index.
     uint32_t add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
                        const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter);
+    // Appends an analytic shape (world space, see geometry/analytic.h). Returns its shape index.
+    uint32_t add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material, int32_t emitter);
 };
 
-// The immutable triangle geometry, shared by every Scene built from one description.
+// The immutable geometry, shared by every Scene built from one description.
 struct Geometry {
     Mesh mesh;
     std::vector<Shape> shapes;
+    std::vector<AnalyticShape> analytic;
     AABB bounds;
 };
 
@@ -78,6 +83,7 @@ public:
     const std::shared_ptr<const Geometry> geometry;
     const Mesh& mesh;                  // geometry->mesh
     const std::vector<Shape>& shapes;  // geometry->shapes
+    const std::vector<AnalyticShape>& analytic;  // geometry->analytic
     const std::shared_ptr<const Accel> accel;
     const std::shared_ptr<const LightSet> light_set;
     const LightSet& lights;            // *light_set
@@ -101,7 +107,8 @@ public:
     std::shared_ptr<const Scene> with_params(const SceneParams& p) const;
     SceneParams params() const { return {camera, settings, materials, emitters}; }
 
-    // Surface data at a hit, with the error bound of the point.
+    // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
+    // of the point.
     SurfaceInteraction interaction(const Hit& hit) const;
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives

@@ -11,7 +11,10 @@ struct PickResult {
     vec3 position{0.f};
     vec3 normal{0.f};    // shading normal
     float distance = 0.f;
-    uint32_t shape = ~0u, material = ~0u, triangle = ~0u;
+    uint32_t shape = ~0u, material = ~0u;
+    uint32_t triangle = ~0u;              // the triangle hit, ~0u on an analytic shape
+    PrimKind kind = PrimKind::Triangle;   // what was hit: a triangle, or a sphere, disk or cylinder
+    vec2 uv{0.f};                         // analytic shapes: Mitsuba's (u, v) there
     int32_t emitter = -1;
 };
 
@@ -32,7 +35,9 @@ inline PickResult pick(const Scene& scene, const Camera& camera, vec2 film_pos) 
     r.distance = glm::length(si.p - camera.origin());
     r.shape = si.shape;
     r.material = shape.material;
-    r.triangle = hit.prim;
+    r.kind = hit.kind;
+    r.triangle = hit.kind == PrimKind::Triangle ? hit.prim : ~0u;
+    r.uv = si.uv;
     r.emitter = shape.emitter;
     return r;
 }

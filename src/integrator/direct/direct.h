@@ -66,7 +66,7 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     SurfaceInteraction si = sc.interaction(hit);
     const vec3 wo_world = -glm::normalize(ray.d);
     vec3 L(0.f);
-    if (!hide && sc.lights.emitter_of(hit.prim) >= 0) L += sc.lights.emitted(si, wo_world);
+    if (!hide && sc.lights.emitter_of(hit) >= 0) L += sc.lights.emitted(si, wo_world);
     if (sc.lights.empty()) return L;
 
     const Material& mat = sc.materials[sc.shapes[si.shape].material];
@@ -111,7 +111,7 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         Ray r = spawn_ray(si, frame.to_world(bs->wi));
         Hit h;
         ++stats.rays;
-        if (!sc.accel->intersect(r, h) || sc.lights.emitter_of(h.prim) < 0) continue;
+        if (!sc.accel->intersect(r, h) || sc.lights.emitter_of(h) < 0) continue;
         const SurfaceInteraction se = sc.interaction(h);
         const vec3 Le = sc.lights.emitted(se, -glm::normalize(r.d));
         if (is_black(Le)) continue;

@@ -3,6 +3,7 @@
 #include <glm/glm.hpp>
 #include <fstream>
 #include "scene/obj.h"
+#include "scene/shapes_analytic.h"
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -79,11 +80,13 @@ const PluginTable<ShapeFactory>& shape_plugins() {
 
 void load_shape(XmlLoader& L, pugi::xml_node n) {
     Object o = L.read_object(n, "shape");
-    ShapeFactory make = L.find_plugin(shape_plugins(), o);
+    const bool analytic = is_analytic_shape_type(o.type);  // intersected exactly, not tessellated
+    ShapeFactory make = analytic ? nullptr : L.find_plugin(shape_plugins(), o, ", sphere, disk, cylinder");
     ++L.shape_counter;
     mat4 m = o.params.get_transform("to_world", mat4(1.f));
     bool flip = o.params.get_bool("flip_normals", false);
-    ShapeGeometry g = make(L, o);
+    ShapeGeometry g = make ? make(L, o) : ShapeGeometry{};
+    AnalyticShape a = analytic ? make_analytic_shape(o.type, o.params, o.line, m, flip) : AnalyticShape{};
     uint32_t material = L.material_for(o);
 
     int32_t emitter = -1;
@@ -94,6 +97,11 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
         c.used = true;
     }
     L.finish(o);
+    if (analytic) {
+        L.scene().add_analytic_shape(n.attribute("id") ? L.attr(n, "id") : o.type + std::to_string(L.shape_counter), a,
+                                     material, emitter);
+        return;
+    }
 
     // To world space: points by M, normals by the inverse transpose.
     glm::mat3 lin(m);
