@@ -14,7 +14,32 @@ void Film::resize(int width, int height) {
     else weight_.clear();
     aov_.assign(n * size_t(aov_channels_), 0.0);
     splat_.clear();
+    if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
     nonfinite_ = 0;
+}
+
+void Film::enable_alpha() {
+    alpha_enabled_ = true;
+    alpha_.assign(sum_.size(), 0.0);
+}
+
+float Film::alpha(int x, int y) const {
+    size_t i = size_t(y) * size_t(width_) + size_t(x);
+    if (!alpha_enabled_) return 0.f;
+    const double norm = weighted_ ? weight_[i] : double(count_[i]);  // filtered like the colour
+    return norm > 0.0 ? float(alpha_[i] / norm) : 0.f;
+}
+
+std::vector<float> Film::resolve_alpha() const {
+    std::vector<float> a(size_t(width_) * size_t(height_));
+    for (int y = 0; y < height_; ++y)
+        for (int x = 0; x < width_; ++x) a[size_t(y) * size_t(width_) + size_t(x)] = alpha(x, y);
+    return a;
+}
+
+void Film::restore_alpha(std::vector<double> sums) {
+    alpha_enabled_ = true;
+    alpha_ = std::move(sums);
 }
 
 void Film::clear() { resize(width_, height_); }
@@ -32,6 +57,7 @@ void Film::merge(const FilmTile& t) {
             const size_t i = size_t(t.y0 + y) * size_t(width_) + size_t(t.x0 + x);
             sum_[i] += t.sum[j];
             weight_[i] += t.weight[j];
+            if (alpha_enabled_) alpha_[i] += t.alpha[j];
             for (int k = 0; k < aov_channels_; ++k)
                 aov_[i * size_t(aov_channels_) + size_t(k)] += t.aov[j * size_t(aov_channels_) + size_t(k)];
         }
@@ -47,6 +73,8 @@ void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int m
     sum.assign(n, dvec3(0.0));
     weight.assign(n, 0.0);
     aov.assign(n * size_t(aov_channels), 0.0);
+    if (film.has_alpha()) alpha.assign(n, 0.0);
+    else alpha.clear();
 }
 
 void Film::add_splat(vec2 film_pos, vec3 L) {

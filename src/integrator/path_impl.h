@@ -40,6 +40,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         ++stats.rays;
         if (!sc.accel->intersect(ray, hit)) break;  // no environment emitter (yet)
         if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, ray, hit, stats)) break;
+        if (depth == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
         vec3 wo_world = -glm::normalize(ray.d);
 

@@ -32,7 +32,8 @@ namespace detail {
 
 // Mitsuba's ImageBlock::put (scalar, non-coalesced): the pixels whose centres lie within the radius
 // of `pos`, with separable discretised weights evaluated in float.
-inline void splat(FilmTile& t, const PixelFilter& f, int film_w, int film_h, vec2 pos, vec3 L, const float* aov) {
+inline void splat(FilmTile& t, const PixelFilter& f, int film_w, int film_h, vec2 pos, vec3 L, const float* aov,
+                  bool covered = false) {
     constexpr int kMax = 2 * 64 + 2;  // the XML reader caps radii at 64 pixels
     const float r = f.radius();
     const vec2 pf = pos - 0.5f;  // pixel centres are at integers + 0.5
@@ -54,6 +55,7 @@ inline void splat(FilmTile& t, const PixelFilter& f, int film_w, int film_h, vec
             const double w = double(wx[x] * wy[y]);
             t.sum[j] += Ld * w;
             t.weight[j] += w;
+            if (!t.alpha.empty() && covered) t.alpha[j] += w;
             for (int k = 0; k < nc; ++k) t.aov[j * size_t(nc) + size_t(k)] += double(aov[k]) * w;
         }
     }
@@ -82,6 +84,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
     const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
     const int n_aov = film.aov_channels();
     const vec3 eye = camera.origin();
+    const bool alpha = film.has_alpha();
     std::atomic<uint64_t> total_rays{0}, total_samples{0};
     std::atomic<bool> stopped{false};
     auto cancelled = [&] {
@@ -105,12 +108,17 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x) {
                     for (int s = 0; s < spp; ++s) {
-                        sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
+                        // Sampler dimensions of a camera sample: the pixel jitter (2), the lens (2, a
+                        // thin lens with an aperture only), then the integrator's.
+                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
                         vec2 jitter = sampler.next_2d();  // uniform over the pixel
-                        Ray ray = camera.generate_ray(vec2(float(x), float(y)) + jitter);
+                        vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
                         if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
+                        const uint64_t hits = ps.camera_hits;
                         vec3 L = li(sampler, ray, ps);
                         film.add_sample(ivec2(x, y), L);
+                        if (alpha) film.add_coverage(ivec2(x, y), ps.camera_hits != hits);
                         if (n_aov > 0) film.add_aov(ivec2(x, y), aov);
                         ++samples;
                     }
@@ -136,17 +144,21 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                 ft.reset(film, tr.x0, tr.y0, tr.x1, tr.y1, filter.reach());
                 for (int y = tr.y0; y < tr.y1; ++y)
                     for (int x = tr.x0; x < tr.x1; ++x) {
-                        sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
-                        vec2 pos = vec2(float(x), float(y)) + sampler.next_2d();
-                        Ray ray = camera.generate_ray(pos);
+                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
+                        const vec2 jitter = sampler.next_2d();
+                        const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                        // The filter works in this film's pixels (a crop window only shifts them).
+                        const vec2 pos = vec2(float(x), float(y)) + jitter;
+                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
                         if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
+                        const uint64_t hits = ps.camera_hits;
                         vec3 L = li(sampler, ray, ps);
                         if (!all_finite(L)) {
                             film.count_nonfinite();
                             L = vec3(0.f);
                         }
                         film.count_sample(ivec2(x, y));
-                        detail::splat(ft, filter, w, h, pos, L, aov);
+                        detail::splat(ft, filter, w, h, pos, L, aov, ps.camera_hits != hits);
                         ++samples;
                     }
                 done[size_t(tile)] = 1;

@@ -28,7 +28,8 @@ enum class SamplingMode { Light, Bsdf, Mis };
 
 // What the scene file says about rendering; the command line may override each field.
 struct RenderSettings {
-    int width = 512, height = 512;
+    int width = 512, height = 512;  // the rendered image: the film, or its crop window (Camera)
+    bool alpha = false;      // hdrfilm pixel_format rgba: the image gets an alpha channel
     int spp = 64;            // sampler sample_count: the default number of passes x spp per pass
     uint64_t seed = 0;
     int max_depth = -1;      // scattering events; -1 = unbounded (Russian roulette ends paths)

@@ -63,6 +63,7 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     if (!sc.accel->intersect(ray, hit)) return vec3(0.f);
     const bool hide = sc.settings.integrator.hide_emitters;
     if (hide && !skip_area_emitters(sc, ray, hit, stats)) return vec3(0.f);
+    ++stats.camera_hits;  // the film's alpha
     SurfaceInteraction si = sc.interaction(hit);
     const vec3 wo_world = -glm::normalize(ray.d);
     vec3 L(0.f);
