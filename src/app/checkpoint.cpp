@@ -204,6 +204,15 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.bytes(m.positions.data(), m.positions.size() * sizeof(vec3));
     h.u64(m.normals.size());
     h.bytes(m.normals.data(), m.normals.size() * sizeof(vec3));
+    // uvs and colours only when present, so that scenes without them keep their fingerprint.
+    if (!m.uvs.empty()) {
+        h.str("uvs");
+        h.bytes(m.uvs.data(), m.uvs.size() * sizeof(vec2));
+    }
+    if (!m.colors.empty()) {
+        h.str("colors");
+        h.bytes(m.colors.data(), m.colors.size() * sizeof(vec3));
+    }
     h.u64(m.triangles.size());
     h.bytes(m.triangles.data(), m.triangles.size() * sizeof(uvec3));
     h.bytes(m.tri_shape.data(), m.tri_shape.size() * sizeof(uint32_t));
@@ -214,6 +223,11 @@ uint64_t scene_fingerprint(const Scene& scene) {
         h.u64(s.smooth);
         h.u64(s.first_triangle);
         h.u64(s.triangle_count);
+        if (s.has_uv() || s.has_color()) {  // only then, so that other scenes keep their fingerprint
+            h.u64(s.first_vertex);
+            h.u64(s.uv_offset);
+            h.u64(s.color_offset);
+        }
     }
     // Analytic shapes (only when there are some: a scene of triangles keeps its fingerprint).
     if (!scene.analytic.empty()) {

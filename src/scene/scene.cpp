@@ -7,7 +7,8 @@ namespace candela {
 
 uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<vec3>& positions,
                                      const std::vector<vec3>& normals, const std::vector<uvec3>& triangles,
-                                     uint32_t material, int32_t emitter) {
+                                     uint32_t material, int32_t emitter, const std::vector<vec2>& uvs,
+                                     const std::vector<vec3>& colors) {
     Shape s;
     s.name = name;
     s.material = material;
@@ -22,6 +23,17 @@ uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<
     if (s.smooth && mesh.normals.size() < base) mesh.normals.resize(base, vec3(0.f));
     if (s.smooth) mesh.normals.insert(mesh.normals.end(), normals.begin(), normals.end());
     else if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
+    s.first_vertex = base;
+    if (!uvs.empty()) {
+        if (uvs.size() != positions.size()) throw Error(name, 0, "texture coordinates are not one per vertex");
+        s.uv_offset = uint32_t(mesh.uvs.size());
+        mesh.uvs.insert(mesh.uvs.end(), uvs.begin(), uvs.end());
+    }
+    if (!colors.empty()) {
+        if (colors.size() != positions.size()) throw Error(name, 0, "vertex colours are not one per vertex");
+        s.color_offset = uint32_t(mesh.colors.size());
+        mesh.colors.insert(mesh.colors.end(), colors.begin(), colors.end());
+    }
     uint32_t shape_index = uint32_t(shapes.size());
     for (const uvec3& t : triangles) {
         mesh.triangles.push_back(t + uvec3(base));
@@ -107,6 +119,24 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
             throw Error(desc.source, 0, "triangle index out of range");
     if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
+    for (size_t i = 0; i < mesh.uvs.size(); ++i)
+        if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y))
+            throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite texture coordinate");
+    for (size_t i = 0; i < mesh.colors.size(); ++i)
+        if (!all_finite(mesh.colors[i]))
+            throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite colour");
+    // A shape's uvs and colours are found from its vertex indices: they must stay in its run.
+    for (const Shape& s : desc.shapes) {
+        if (!s.has_uv() && !s.has_color()) continue;
+        for (uint32_t i = s.first_triangle; i < s.first_triangle + s.triangle_count && i < mesh.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                uint32_t v = mesh.triangles[i][k];
+                bool ok = v >= s.first_vertex &&
+                          (!s.has_uv() || uint64_t(v - s.first_vertex) + s.uv_offset < mesh.uvs.size()) &&
+                          (!s.has_color() || uint64_t(v - s.first_vertex) + s.color_offset < mesh.colors.size());
+                if (!ok) throw Error(desc.source, 0, "shape '" + s.name + "' has a vertex without its uv or colour");
+            }
+    }
     SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters)};
     check_params(desc.source, desc.shapes, params);
 
@@ -158,14 +188,46 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
         float l2 = glm::dot(n, n);
         if (l2 > 0.f && std::isfinite(l2)) si.ns = n / std::sqrt(l2);
     }
+    // Mitsuba 3's mesh parameterisation (Mesh::compute_surface_interaction).
+    vec3 dp0 = p1 - p0, dp1 = p2 - p0;
+    const Shape& shape = shapes[si.shape];
+    if (shape.has_uv()) {
+        const vec2* uv = mesh.uvs.data() + shape.uv_offset - shape.first_vertex;
+        vec2 uv0 = uv[t.x], uv1 = uv[t.y], uv2 = uv[t.z];
+        si.uv = b0 * uv0 + hit.b1 * uv1 + hit.b2 * uv2;
+        vec2 duv0 = uv1 - uv0, duv1 = uv2 - uv0;
+        float det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if (det != 0.f && std::isfinite(1.f / det)) {
+            float inv = 1.f / det;
+            si.dpdu = (duv1.y * dp0 - duv0.y * dp1) * inv;
+            si.dpdv = (duv0.x * dp1 - duv1.x * dp0) * inv;
+        } else {
+            Frame f(si.ng);
+            si.dpdu = f.s;
+            si.dpdv = f.t;
+        }
+    } else {
+        si.uv = vec2(hit.b1, hit.b2);
+        si.dpdu = dp0;
+        si.dpdv = dp1;
+    }
     return si;
+}
+
+vec3 Scene::vertex_color(const Hit& hit) const {
+    const Shape& shape = shapes[mesh.tri_shape[hit.prim]];
+    if (!shape.has_color()) return vec3(0.f);
+    const vec3* c = mesh.colors.data() + shape.color_offset - shape.first_vertex;
+    const uvec3& t = mesh.triangles[hit.prim];
+    return (1.f - hit.b1 - hit.b2) * c[t.x] + hit.b1 * c[t.y] + hit.b2 * c[t.z];
 }
 
 Scene::Memory Scene::memory() const {
     Memory m;
     m.triangles = mesh.triangles.size();
     m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
-             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t);
+             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t) +
+             mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
     m.accel = accel ? accel->memory_bytes() : 0;
     m.lights = lights.memory_bytes();
     return m;

@@ -61,9 +61,11 @@ struct SceneDescription {
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
 
-    // Appends a shape made of the given triangles (world space). Returns its index.
+    // Appends a shape made of the given triangles (world space). Returns its index. `uvs` and
+    // `colors` are per vertex or empty (then the mesh stores none for this shape).
     uint32_t add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
-                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter);
+                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter,
+                       const std::vector<vec2>& uvs = {}, const std::vector<vec3>& colors = {});
     // Appends an analytic shape (world space, see geometry/analytic.h). Returns its shape index.
     uint32_t add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material, int32_t emitter);
 };
@@ -111,6 +113,10 @@ public:
     // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
     // of the point.
     SurfaceInteraction interaction(const Hit& hit) const;
+    // The vertex colours interpolated at a hit (Mitsuba's mesh attribute "vertex_color", what a
+    // mesh_attribute texture reads); zero on a shape without colours. Apart from interaction() so
+    // that only shading that reads colours pays for them.
+    vec3 vertex_color(const Hit& hit) const;
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.
