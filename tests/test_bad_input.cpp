@@ -159,9 +159,9 @@ TEST(BadInput, UnsupportedFeatures) {
     std::string d = temp_dir("bad-unsupported");
     write_text(d + "/inc.xml", xml("\n<include filename=\"other.xml\"/>\n"));
     expect_clean_error(render(d + "/inc.xml", d), {d + "/inc.xml:3: ", "include"});
-    write_text(d + "/hide.xml", xml("<integrator type=\"path\">\n<boolean name=\"hide_emitters\" value=\"true\"/>"
-                                    "</integrator>\n"));
-    expect_clean_error(render(d + "/hide.xml", d), {d + "/hide.xml:3: ", "not supported"});
+    write_text(d + "/aov.xml", xml("<integrator type=\"aov\">\n<string name=\"aovs\" value=\"u:uv\"/>"
+                                   "<integrator type=\"path\"/></integrator>\n"));
+    expect_clean_error(render(d + "/aov.xml", d), {d + "/aov.xml:3: ", "not supported"});
     write_text(d + "/nurbs.obj", "v 0 0 0\ncstype bspline\n");
     expect_clean_error(render(d + "/nurbs.obj", d), {d + "/nurbs.obj:2: free-form geometry"});
     write_text(d + "/scene.ply", "ply\n");

@@ -75,10 +75,11 @@ static_assert(sizeof(vec3) == 12 && sizeof(uvec3) == 12 && sizeof(dvec3) == 24, 
 // ---- the file format -----------------------------------------------------------------------------
 // Native byte order (x86-64 and ARM64 are both little-endian; a marker catches any other):
 //   0  char[8]  magic "CNDLCKPT"      8  u32 version          12 u32 header size (64)
-//   16 i32 width                      20 i32 height           24 u32 spp        28 u32 flags (1: alpha)
+//   16 i32 width                      20 i32 height           24 u32 spp        28 u32 flags (1: alpha, 2: weighted)
 //   32 u64 non-finite samples         40 u64 fingerprint      48 u64 pixels     56 u64 byte-order marker
-//   64 pixels x 3 f64 sums, then pixels x u32 counts, then (flag alpha) pixels x f64 alpha sums,
-//   then u64 hash of everything before it.
+//   64 pixels x 3 f64 sums, then pixels x u32 counts, then (flag alpha) pixels x f64 alpha sums, then
+//   (flag weighted: tent, gaussian filters) pixels x f64 weight sums, then u64 hash of everything
+//   before it. Box-filtered files without alpha are those of before.
 constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderSize = 64;
@@ -180,6 +181,22 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.i64(st.max_depth);
     h.i64(st.rr_depth);
     h.i64(int(st.sampling));
+    // The integrator and the filter (a default-constructed description adds nothing, so that
+    // checkpoints of box-filtered path tracing made before they existed stay valid).
+    const IntegratorDesc& in = st.integrator;
+    if (in.type != IntegratorType::Path || in.hide_emitters) {
+        h.str("integrator");
+        h.i64(int(in.type));
+        h.u64(in.hide_emitters);
+        h.i64(in.emitter_samples);
+        h.i64(in.bsdf_samples);
+    }
+    if (st.filter != FilterDesc()) {
+        h.str("filter");
+        h.i64(int(st.filter.type));
+        h.f32(st.filter.radius);
+        h.f32(st.filter.stddev);
+    }
     h.str(scene.accel ? scene.accel->name() : std::string());
 
     const Mesh& m = scene.mesh;
@@ -294,7 +311,7 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     put<int32_t>(header, 16, film.width());
     put<int32_t>(header, 20, film.height());
     put<uint32_t>(header, 24, spp);
-    put<uint32_t>(header, 28, film.has_alpha() ? 1u : 0u);
+    put<uint32_t>(header, 28, (film.has_alpha() ? 1u : 0u) | (film.weighted() ? 2u : 0u));
     put<uint64_t>(header, 32, film.nonfinite_count());
     put<uint64_t>(header, 40, fingerprint);
     put<uint64_t>(header, 48, uint64_t(sums.size()));
@@ -305,6 +322,7 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     w.write(sums.data(), sums.size() * sizeof(dvec3));
     w.write(counts.data(), counts.size() * sizeof(uint32_t));
     if (film.has_alpha()) w.write(film.alpha_sums().data(), film.alpha_sums().size() * sizeof(double));
+    if (film.weighted()) w.write(film.weights().data(), film.weights().size() * sizeof(double));
     uint64_t check = w.hash();
     w.write(&check, sizeof check);
     w.commit();
@@ -340,12 +358,13 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         pixels != uint64_t(info.width) * uint64_t(info.height))
         throw Error(path, 0, "corrupt checkpoint (bad image size)");
     const uint32_t flags = get<uint32_t>(header, 28);
-    if (flags > 1) throw Error(path, 0, "corrupt checkpoint (unknown flags)");
-    const bool alpha = flags == 1;
+    if (flags > 3) throw Error(path, 0, "corrupt checkpoint (unknown flags)");
+    const bool alpha = (flags & 1u) != 0, weighted = (flags & 2u) != 0;
     if (alpha != film.has_alpha())
         throw Error(path, 0, std::string("checkpoint ") + (alpha ? "has" : "has no") + " alpha channel, this render " +
                                  (film.has_alpha() ? "has one" : "has none") + "; refusing to resume");
-    const uint64_t expected = kHeaderSize + pixels * (kBytesPerPixel + (alpha ? sizeof(double) : 0)) + 8;
+    const uint64_t expected =
+        kHeaderSize + pixels * (kBytesPerPixel + (alpha ? sizeof(double) : 0) + (weighted ? sizeof(double) : 0)) + 8;
     if (file_size != expected)
         throw Error(path, 0, "truncated or corrupt checkpoint (" + std::to_string(file_size) + " bytes, expected " +
                                  std::to_string(expected) + ")");
@@ -357,12 +376,17 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         throw Error(path, 0, "checkpoint was made for another scene or other settings (fingerprint " +
                                  hex(info.fingerprint) + ", this render " + hex(fingerprint) + "); refusing to resume");
 
+    if (weighted != film.weighted())
+        throw Error(path, 0, std::string("checkpoint was made with ") + (weighted ? "a wide" : "the box") +
+                                 " pixel filter, this render uses " + (film.weighted() ? "a wide one" : "the box"));
     std::vector<dvec3> sums(static_cast<size_t>(pixels));
+    std::vector<double> weights(weighted ? static_cast<size_t>(pixels) : 0);
     std::vector<uint32_t> counts(static_cast<size_t>(pixels));
     read_exact(f.get(), sums.data(), sums.size() * sizeof(dvec3), path);
     read_exact(f.get(), counts.data(), counts.size() * sizeof(uint32_t), path);
     std::vector<double> alpha_sums(alpha ? static_cast<size_t>(pixels) : 0);
     if (alpha) read_exact(f.get(), alpha_sums.data(), alpha_sums.size() * sizeof(double), path);
+    read_exact(f.get(), weights.data(), weights.size() * sizeof(double), path);
     uint64_t stored = 0;
     read_exact(f.get(), &stored, sizeof stored, path);
     Hasher h;
@@ -370,6 +394,7 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
     h.bytes(sums.data(), sums.size() * sizeof(dvec3));
     h.bytes(counts.data(), counts.size() * sizeof(uint32_t));
     if (alpha) h.bytes(alpha_sums.data(), alpha_sums.size() * sizeof(double));
+    h.bytes(weights.data(), weights.size() * sizeof(double));
     if (h.digest() != stored) throw Error(path, 0, "corrupt checkpoint (checksum mismatch)");
     // Whole passes only, and sums the film could have made (non-finite samples never enter them).
     for (uint32_t c : counts)
@@ -378,10 +403,14 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z))
             throw Error(path, 0, "corrupt checkpoint (non-finite sum)");
     if (info.nonfinite > pixels * uint64_t(info.spp)) throw Error(path, 0, "corrupt checkpoint (non-finite count)");
-    for (size_t i = 0; i < alpha_sums.size(); ++i)
-        if (!(alpha_sums[i] >= 0.0 && alpha_sums[i] <= double(info.spp)))
-            throw Error(path, 0, "corrupt checkpoint (alpha out of range)");
-    film.restore(std::move(sums), std::move(counts), info.nonfinite);
+    for (double w : weights)
+        if (!(w >= 0.0) || !std::isfinite(w)) throw Error(path, 0, "corrupt checkpoint (bad filter weight)");
+    // Alpha sums are coverage x (1 per sample, or the filter weight): at most the count or weight sum.
+    for (size_t i = 0; i < alpha_sums.size(); ++i) {
+        const double limit = weighted ? weights[i] * (1.0 + 1e-9) : double(info.spp);
+        if (!(alpha_sums[i] >= 0.0 && alpha_sums[i] <= limit)) throw Error(path, 0, "corrupt checkpoint (alpha out of range)");
+    }
+    film.restore(std::move(sums), std::move(counts), info.nonfinite, std::move(weights));
     if (alpha) film.restore_alpha(std::move(alpha_sums));
     return info;
 }

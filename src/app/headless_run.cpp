@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/progress.h"
+#include "film/exr_layers.h"
 #include "film/film.h"
 #include "film/image_io.h"
 #include "headless/headless.h"
@@ -134,7 +135,13 @@ int run_headless(const HeadlessOptions& opt) {
     const uint64_t target = frames * uint64_t(spp_per_pass);
     if (target > std::numeric_limits<uint32_t>::max())
         throw Error("--frames x --spp-per-frame is " + std::to_string(target) + " samples per pixel, more than 2^32 - 1");
+    const std::vector<AovSpec>& aovs = st.integrator.aovs;
+    if (!aovs.empty() && !opt.checkpoint.empty())
+        throw Error(opt.checkpoint, 0, "checkpoints do not hold the aov integrator's layers; render it without --checkpoint");
+    if (!aovs.empty() && !opt.resume.empty())
+        throw Error(opt.resume, 0, "checkpoints do not hold the aov integrator's layers; render it without --resume");
     Film film(st.width, st.height);
+    configure_film(film, st);
     if (st.alpha) film.enable_alpha();
     int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
 
@@ -232,7 +239,16 @@ int run_headless(const HeadlessOptions& opt) {
     if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
     std::string written = opt.out;
     bool png_failed = false;
-    if (ext == ".png") {
+    if (!aovs.empty() && ext == ".exr") {
+        std::vector<std::string> names = aov_channel_names(aovs);
+        std::vector<std::vector<float>> planes = film.resolve_aovs();
+        std::vector<ExrLayer> layers;
+        for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
+        write_exr_layers(opt.out, img, layers);
+    } else if (ext == ".png") {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
         // The PNG goes through GL; if that fails the samples must not go with it.
         try {
             write_png_headless(opt.out, img, opt.display);
@@ -246,6 +262,9 @@ int run_headless(const HeadlessOptions& opt) {
                          opt.out.c_str(), written.c_str());
         }
     } else {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
         write_linear_image(opt.out, img);
     }
 

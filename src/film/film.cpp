@@ -1,4 +1,5 @@
 #include "film/film.h"
+#include <algorithm>
 #include <mutex>
 
 namespace candela {
@@ -6,8 +7,12 @@ namespace candela {
 void Film::resize(int width, int height) {
     width_ = width;
     height_ = height;
-    sum_.assign(size_t(width) * size_t(height), dvec3(0.0));
-    count_.assign(size_t(width) * size_t(height), 0u);
+    const size_t n = size_t(width) * size_t(height);
+    sum_.assign(n, dvec3(0.0));
+    count_.assign(n, 0u);
+    if (weighted_) weight_.assign(n, 0.0);
+    else weight_.clear();
+    aov_.assign(n * size_t(aov_channels_), 0.0);
     splat_.clear();
     if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
     nonfinite_ = 0;
@@ -20,7 +25,9 @@ void Film::enable_alpha() {
 
 float Film::alpha(int x, int y) const {
     size_t i = size_t(y) * size_t(width_) + size_t(x);
-    return count_[i] > 0 && alpha_enabled_ ? float(alpha_[i] / double(count_[i])) : 0.f;
+    if (!alpha_enabled_) return 0.f;
+    const double norm = weighted_ ? weight_[i] : double(count_[i]);  // filtered like the colour
+    return norm > 0.0 ? float(alpha_[i] / norm) : 0.f;
 }
 
 std::vector<float> Film::resolve_alpha() const {
@@ -36,6 +43,39 @@ void Film::restore_alpha(std::vector<double> sums) {
 }
 
 void Film::clear() { resize(width_, height_); }
+
+void Film::set_layout(bool weighted, int aov_channels) {
+    weighted_ = weighted;
+    aov_channels_ = std::max(0, aov_channels);
+    resize(width_, height_);
+}
+
+void Film::merge(const FilmTile& t) {
+    for (int y = 0; y < t.height; ++y)
+        for (int x = 0; x < t.width; ++x) {
+            const size_t j = size_t(y) * size_t(t.width) + size_t(x);
+            const size_t i = size_t(t.y0 + y) * size_t(width_) + size_t(t.x0 + x);
+            sum_[i] += t.sum[j];
+            weight_[i] += t.weight[j];
+            if (alpha_enabled_) alpha_[i] += t.alpha[j];
+            for (int k = 0; k < aov_channels_; ++k)
+                aov_[i * size_t(aov_channels_) + size_t(k)] += t.aov[j * size_t(aov_channels_) + size_t(k)];
+        }
+}
+
+void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int margin) {
+    x0 = std::max(0, tx0 - margin);
+    y0 = std::max(0, ty0 - margin);
+    width = std::min(film.width(), tx1 + margin) - x0;
+    height = std::min(film.height(), ty1 + margin) - y0;
+    aov_channels = film.aov_channels();
+    const size_t n = size_t(width) * size_t(height);
+    sum.assign(n, dvec3(0.0));
+    weight.assign(n, 0.0);
+    aov.assign(n * size_t(aov_channels), 0.0);
+    if (film.has_alpha()) alpha.assign(n, 0.0);
+    else alpha.clear();
+}
 
 void Film::add_splat(vec2 film_pos, vec3 L) {
     int x = int(film_pos.x), y = int(film_pos.y);
@@ -54,9 +94,25 @@ void Film::add_splat(vec2 film_pos, vec3 L) {
 
 vec3 Film::pixel(int x, int y) const {
     size_t i = size_t(y) * size_t(width_) + size_t(x);
-    dvec3 v = count_[i] > 0 ? sum_[i] / double(count_[i]) : dvec3(0.0);
+    dvec3 v;
+    if (weighted_) v = weight_[i] > 0.0 ? sum_[i] / weight_[i] : dvec3(0.0);
+    else v = count_[i] > 0 ? sum_[i] / double(count_[i]) : dvec3(0.0);
     if (!splat_.empty()) v += splat_[i] * splat_scale_;
     return vec3(v);
+}
+
+float Film::aov(int x, int y, int k) const {
+    size_t i = size_t(y) * size_t(width_) + size_t(x);
+    double norm = weighted_ ? weight_[i] : double(count_[i]);
+    return norm > 0.0 ? float(aov_[i * size_t(aov_channels_) + size_t(k)] / norm) : 0.f;
+}
+
+std::vector<std::vector<float>> Film::resolve_aovs() const {
+    std::vector<std::vector<float>> out(size_t(aov_channels_), std::vector<float>(size_t(width_) * size_t(height_)));
+    for (int y = 0; y < height_; ++y)
+        for (int x = 0; x < width_; ++x)
+            for (int k = 0; k < aov_channels_; ++k) out[size_t(k)][size_t(y) * size_t(width_) + size_t(x)] = aov(x, y, k);
+    return out;
 }
 
 void Film::resolve_into(std::vector<float>& rgb) const {
@@ -83,9 +139,11 @@ uint64_t Film::total_samples() const {
     return n;
 }
 
-void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite) {
+void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite,
+                   std::vector<double> weights) {
     sum_ = std::move(sums);
     count_ = std::move(counts);
+    weight_ = std::move(weights);
     nonfinite_ = nonfinite;
 }
 

@@ -13,13 +13,27 @@ namespace candela {
 //
 // Non-finite samples never enter the sums: they are counted (nonfinite_count) and recorded as a
 // zero-radiance sample, so that the pixel's sample count stays the number of samples taken.
+//
+// Two layouts (set_layout). Unweighted (the box filter of radius 0.5, the default): a pixel is the
+// plain mean of its own samples, sum / count. Weighted (tent, gaussian: film/filter.h): samples
+// splat into neighbouring pixels with filter weights, so each pixel also keeps the sum of the
+// weights it received and is sum(w L) / sum(w); count stays the number of samples taken IN the
+// pixel. Splatting crosses tiles, so a weighted pass accumulates each tile into a FilmTile (the
+// tile plus a margin) and merges the tiles in a fixed order (merge): the sums then do not depend on
+// the thread schedule. Optional AOV channels (aov_channels > 0) are filtered the same way.
+struct FilmTile;
+
 class Film {
 public:
     Film() = default;
     Film(int width, int height) { resize(width, height); }
 
-    void resize(int width, int height);
+    void resize(int width, int height);  // keeps the layout
     void clear();
+    // Weighted or not, and how many AOV channels per pixel. Clears the film.
+    void set_layout(bool weighted, int aov_channels);
+    bool weighted() const { return weighted_; }
+    int aov_channels() const { return aov_channels_; }
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -33,6 +47,17 @@ public:
         sum_[i] += dvec3(L);
         count_[i] += 1;
     }
+    // Unweighted layout: the AOV values (aov_channels floats) of a sample added to pixel px.
+    void add_aov(ivec2 px, const float* v) {
+        double* a = &aov_[(size_t(px.y) * size_t(width_) + size_t(px.x)) * size_t(aov_channels_)];
+        for (int k = 0; k < aov_channels_; ++k) a[k] += double(v[k]);
+    }
+    // Weighted layout: counts a sample taken in pixel px (the tile that owns px calls it, so no
+    // two threads touch one pixel) and the non-finite ones.
+    void count_sample(ivec2 px) { count_[size_t(px.y) * size_t(width_) + size_t(px.x)] += 1; }
+    void count_nonfinite() { nonfinite_.fetch_add(1, std::memory_order_relaxed); }
+    // Weighted layout: adds a tile's sums into the film. Call from one thread, tiles in a fixed order.
+    void merge(const FilmTile& tile);
     // Alpha (hdrfilm pixel_format rgba): per pixel, the fraction of its samples whose camera ray
     // hit a surface, as Mitsuba. Off (and not allocated) until enable_alpha; kept over resize.
     void enable_alpha();
@@ -46,8 +71,12 @@ public:
     // Splats are scaled by 1 / (passes) when resolved: splat_scale is set by the integrator.
     void add_splat(vec2 film_pos, vec3 L);
 
-    // Mean radiance of a pixel (the box-filtered estimate), plus splats.
+    // Mean radiance of a pixel (sum / count, or sum(w L) / sum(w) when weighted), plus splats.
     vec3 pixel(int x, int y) const;
+    // AOV channel k of a pixel, normalised like pixel().
+    float aov(int x, int y, int k) const;
+    // The AOV channels as float images, channel-major: aov_channels x (width x height).
+    std::vector<std::vector<float>> resolve_aovs() const;
     uint32_t sample_count(int x, int y) const { return count_[size_t(y) * size_t(width_) + size_t(x)]; }
     dvec3 pixel_sum(int x, int y) const { return sum_[size_t(y) * size_t(width_) + size_t(x)]; }
     // RGB float image, row-major from the top-left, 3 floats per pixel.
@@ -63,10 +92,17 @@ public:
     // Raw state for checkpoints.
     const std::vector<dvec3>& sums() const { return sum_; }
     const std::vector<uint32_t>& counts() const { return count_; }
-    void restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite);
+    const std::vector<double>& weights() const { return weight_; }  // weighted layout only
+    // `weights` must be empty for an unweighted film and one per pixel for a weighted one.
+    void restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite,
+                 std::vector<double> weights = {});
 
 private:
     int width_ = 0, height_ = 0;
+    bool weighted_ = false;
+    int aov_channels_ = 0;
+    std::vector<double> weight_;  // weighted layout: sum of filter weights per pixel
+    std::vector<double> aov_;     // aov_channels_ per pixel (weighted sums when weighted_)
     std::vector<dvec3> sum_;
     std::vector<uint32_t> count_;
     std::vector<dvec3> splat_;
@@ -74,6 +110,20 @@ private:
     std::vector<double> alpha_;  // sums of coverage (0 or 1 per sample)
     double splat_scale_ = 1.0;
     std::atomic<uint64_t> nonfinite_{0};
+};
+
+// A tile's share of a weighted pass: the tile's pixels plus `margin` on each side (clipped to the
+// film), with the weighted sums its samples made.
+struct FilmTile {
+    int x0 = 0, y0 = 0, width = 0, height = 0;  // the region covered, film pixels
+    int aov_channels = 0;
+    std::vector<dvec3> sum;
+    std::vector<double> weight, aov;
+    std::vector<double> alpha;  // when the film has alpha: coverage x weight
+
+    // Covers the film pixels [x0 - margin, x1 + margin) x [y0 - margin, y1 + margin) clipped to the
+    // film, zeroed (reusing the buffers).
+    void reset(const Film& film, int x0, int y0, int x1, int y1, int margin);
 };
 
 }  // namespace candela

@@ -9,6 +9,20 @@ inline float power_heuristic(float a, float b) {
     return a2 + b2 > 0.f ? a2 / (a2 + b2) : 0.f;
 }
 
+// Mitsuba 3's hide_emitters: a camera ray that hits an area emitter goes on through it, and through
+// every further emitter, to the first surface that does not emit (Integrator::skip_area_emitters).
+// `ray` and `hit` become that continuation. Returns false when it hits nothing.
+inline bool skip_area_emitters(const Scene& sc, Ray& ray, Hit& hit, PathStats& stats) {
+    for (int i = 0; i < 1024 && sc.lights.emitter_of(hit) >= 0; ++i) {
+        const SurfaceInteraction si = sc.interaction(hit);
+        ray = spawn_ray(si, ray.d);  // unbounded, as Mitsuba's si.spawn_ray: the far clip is not kept
+        hit = Hit();
+        ++stats.rays;
+        if (!sc.accel->intersect(ray, hit)) return false;
+    }
+    return true;
+}
+
 template <class S, bool DiffuseOnly>
 vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const Scene& sc = scene_;
@@ -25,6 +39,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         Hit hit;
         ++stats.rays;
         if (!sc.accel->intersect(ray, hit)) break;  // no environment emitter (yet)
+        if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, ray, hit, stats)) break;
         if (depth == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
         vec3 wo_world = -glm::normalize(ray.d);

@@ -15,8 +15,10 @@
 #include <vector>
 #include "accel/accel.h"
 #include "bsdf/bsdf.h"
+#include "film/filter.h"
 #include "geometry/analytic.h"
 #include "geometry/mesh.h"
+#include "integrator/desc.h"
 #include "light/area.h"
 #include "scene/camera.h"
 
@@ -33,6 +35,8 @@ struct RenderSettings {
     int max_depth = -1;      // scattering events; -1 = unbounded (Russian roulette ends paths)
     int rr_depth = 5;        // scattering events before Russian roulette starts
     SamplingMode sampling = SamplingMode::Mis;
+    IntegratorDesc integrator;  // which integrator renders the passes (the scene's <integrator>)
+    FilterDesc filter;          // the film's reconstruction filter (box unless the scene says)
 };
 
 // Everything the image depends on that can change without rebuilding the geometry: what the viewer

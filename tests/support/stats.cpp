@@ -536,11 +536,14 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
     const double K = double(batches.size());
     im.mean.assign(n, dvec3(0.0));
     im.var_of_mean.assign(n, dvec3(0.0));
+    // A weighted film (tent, gaussian) normalises by its weight sums, a box-filtered one by counts;
+    // the batch means are then ratio estimators, whose spread still gives the variance.
+    auto norm = [](const Film* f, size_t i) { return f->weighted() ? f->weights()[i] : double(f->counts()[i]); };
     for (size_t i = 0; i < n; ++i) {
         double total = 0;
         dvec3 sum(0.0);
         for (const Film* f : batches) {
-            total += double(f->counts()[i]);
+            total += norm(f, i);
             sum += f->sums()[i];
         }
         if (total <= 0) continue;
@@ -550,7 +553,7 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
         // which is s^2 / K for equal batches.
         dvec3 v(0.0);
         for (const Film* f : batches) {
-            double c = double(f->counts()[i]);
+            double c = norm(f, i);
             if (c <= 0) continue;
             double w = c / total;
             dvec3 d = f->sums()[i] / c - m;

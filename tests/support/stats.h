@@ -171,6 +171,7 @@ struct ImageEstimate {
     // From K >= 2 independent films of the same scene (different seeds or sample ranges): the mean
     // is the sample-count-weighted mean, and the variance of the mean comes from the spread of the
     // K batch means ("batch means"), so no second moment has to be stored while rendering.
+    // Weighted films (tent, gaussian filters) are normalised by their weight sums instead of counts.
     static ImageEstimate from_batches(const std::vector<const Film*>& batches);
     // A committed reference: its mean image and a per-pixel variance-of-the-mean image.
     static ImageEstimate from_film(const Film& film, const std::vector<dvec3>& var_of_mean);

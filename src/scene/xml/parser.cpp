@@ -855,6 +855,7 @@ SceneDescription XmlLoader::load() {
             scene_.settings.width = 768;
             scene_.settings.height = 576;
             scene_.settings.spp = 4;
+            scene_.settings.filter = gaussian_filter();
         }
     } catch (const Error& e) {
         // What Mitsuba 3's upgrade rules leave for a 0.x/1.x file (other plugin names, parameters

@@ -37,14 +37,13 @@ void load_emitter(XmlLoader& L, pugi::xml_node n);  // top level
 // ---- sensors.cpp: <sensor> with its <film> (and <rfilter>) and <sampler> ----
 using SensorFactory = Camera (*)(XmlLoader&, Object&);
 using FilmFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
-using RFilterFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
 using SamplerFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
 const PluginTable<SensorFactory>& sensor_plugins();
 const PluginTable<FilmFactory>& film_plugins();
-const PluginTable<RFilterFactory>& rfilter_plugins();
 const PluginTable<SamplerFactory>& sampler_plugins();
 void load_sensor(XmlLoader& L, pugi::xml_node n);
-// A film's nested <rfilter> elements (at most one), for film factories.
+// A film's nested <rfilter> (at most one; gaussian without one), for film factories. The filter
+// factories are read_rfilter (scene/plugins/render_factories.h).
 void load_rfilters(XmlLoader& L, Object& film, RenderSettings& s);
 
 // ---- textures.cpp: <texture> -> Texture, and texture-valued parameters of other plugins ----
@@ -57,9 +56,8 @@ std::shared_ptr<const Texture> nested_texture(XmlLoader& L, Object& o, const std
 // A colour parameter given as a value or as a texture: the texture (a constant one for a value).
 std::shared_ptr<const Texture> rgb_or_texture(XmlLoader& L, Object& o, const std::string& name, vec3 def);
 
-// ---- integrators.cpp: <integrator> -> RenderSettings ----
-using IntegratorFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
-const PluginTable<IntegratorFactory>& integrator_plugins();
+// ---- integrators.cpp: <integrator> -> RenderSettings (factories: read_integrator,
+// scene/plugins/render_factories.h; this walks the moment/aov wrappers) ----
 void load_integrator(XmlLoader& L, pugi::xml_node n);
 
 }  // namespace xml

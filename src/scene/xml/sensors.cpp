@@ -1,6 +1,7 @@
 // The sensor family of the XML reader: sensors (the camera), and the film, reconstruction filter
 // and sampler nested in them (the settings they set).
 #include <glm/glm.hpp>
+#include "scene/plugins/render_factories.h"
 #include "scene/sensors.h"
 #include "scene/xml/plugins.h"
 
@@ -22,8 +23,6 @@ void make_hdrfilm(XmlLoader& L, Object& o, RenderSettings& s) {
     s.height = image.y;
     s.alpha = f.alpha;
 }
-
-void make_box(XmlLoader&, Object&, RenderSettings&) {}
 
 void make_independent(XmlLoader&, Object& o, RenderSettings& s) {
     int spp = o.params.get_int("sample_count", 4);
@@ -52,13 +51,6 @@ const PluginTable<FilmFactory>& film_plugins() {
     return table;
 }
 
-const PluginTable<RFilterFactory>& rfilter_plugins() {
-    static const PluginTable<RFilterFactory> table = {
-        {"box", make_box},
-    };
-    return table;
-}
-
 const PluginTable<SamplerFactory>& sampler_plugins() {
     static const PluginTable<SamplerFactory> table = {
         {"independent", make_independent},
@@ -68,19 +60,15 @@ const PluginTable<SamplerFactory>& sampler_plugins() {
 
 void load_rfilters(XmlLoader& L, Object& film, RenderSettings& s) {
     bool have_filter = false;
+    s.filter = gaussian_filter();  // Mitsuba's default without an <rfilter>
     for (Nested& c : film.nested) {
         if (c.tag != "rfilter") continue;
         if (have_filter) throw L.error(c.node, "more than one <rfilter>");
         Object f = L.read_object(c.node, "rfilter");
-        RFilterFactory make = L.find_plugin(rfilter_plugins(), f);
-        make(L, f, s);
+        s.filter = read_rfilter(f.type, f.params, f.line);  // scene/plugins/render_factories.cpp
         L.finish(f);
         c.used = have_filter = true;
     }
-    if (!have_filter)  // no filters yet; many scenes omit rfilter, so this is not an error
-        L.scene().warnings.push_back(L.file_of(film.node) + ":" + std::to_string(L.line(film.node)) +
-                                     ": film without <rfilter>: candela renders with a box filter, where Mitsuba 3 "
-                                     "would use its default gaussian");
 }
 
 void load_sensor(XmlLoader& L, pugi::xml_node n) {
@@ -96,6 +84,7 @@ void load_sensor(XmlLoader& L, pugi::xml_node n) {
     s.alpha = false;
     L.scene().camera = cam;
     s.spp = 4;
+    s.filter = gaussian_filter();
     s.seed = 0;
     bool film = false, sampler = false;
     for (Nested& c : o.nested) {

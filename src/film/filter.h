@@ -1,0 +1,64 @@
+#pragma once
+// Pixel reconstruction filters, as Mitsuba 3 defines and applies them (src/rfilters/*.cpp,
+// src/core/rfilter.cpp, src/render/imageblock.cpp in its scalar variants):
+//   * a sample taken at film position p (pixels; pixel i covers [i, i + 1), its centre is i + 0.5)
+//     adds w(x) w(y) L to every pixel whose centre lies within the filter's radius of p, where
+//     x, y are the offsets from p to the pixel's centre;
+//   * the pixel is then sum(w L) / sum(w) over the samples that reached it.
+// The sample positions stay uniform in their own pixel (no filter importance sampling), so a
+// pixel's value is a ratio estimator, consistent but not unbiased at low sample counts.
+// Weights are Mitsuba's discretised ones: the 1D filter tabulated at 31 points over [0, radius),
+// looked up by truncation (ReconstructionFilter::eval_discretized), evaluated in float.
+#include <cstdint>
+
+namespace candela {
+
+enum class FilterType { Box, Tent, Gaussian };
+
+// What the scene file asks for. Box has radius 0.5 (Mitsuba's box takes no parameters); tent's
+// radius defaults to 1; gaussian's stddev to 0.5, with radius 4 stddev.
+struct FilterDesc {
+    FilterType type = FilterType::Box;
+    float radius = 0.5f;  // tent: the radius; gaussian: derived (4 stddev); box: 0.5
+    float stddev = 0.5f;  // gaussian only
+    bool is_box() const { return type == FilterType::Box; }
+};
+inline bool operator==(const FilterDesc& a, const FilterDesc& b) {
+    return a.type == b.type && a.radius == b.radius && a.stddev == b.stddev;
+}
+inline bool operator!=(const FilterDesc& a, const FilterDesc& b) { return !(a == b); }
+
+FilterDesc box_filter();
+FilterDesc tent_filter(float radius = 1.f);
+FilterDesc gaussian_filter(float stddev = 0.5f);
+const char* filter_name(FilterType t);
+
+// The filter ready for splatting.
+class PixelFilter {
+public:
+    static constexpr int kResolution = 31;  // MI_FILTER_RESOLUTION
+
+    explicit PixelFilter(const FilterDesc& d);
+
+    float radius() const { return radius_; }
+    // Pixels a sample may reach beyond its own pixel on each side.
+    int reach() const { return reach_; }
+    // The continuous filter (Mitsuba's eval()).
+    float eval(float x) const;
+    // The tabulated filter the film uses (Mitsuba's eval_discretized in scalar variants).
+    float eval_discretized(float x) const {
+        float a = x < 0.f ? -x : x;
+        uint32_t i = uint32_t(a * scale_);
+        return values_[i < uint32_t(kResolution) ? i : uint32_t(kResolution)];
+    }
+
+private:
+    FilterDesc desc_;
+    float radius_ = 0.5f, scale_ = 0.f;
+    float inv_radius_ = 2.f;           // tent: 1 - |x inv_radius|
+    float alpha_ = 0.f, bias_ = 0.f;  // gaussian: exp(alpha x^2) - bias
+    int reach_ = 0;
+    float values_[kResolution + 1] = {};
+};
+
+}  // namespace candela

@@ -1,0 +1,49 @@
+#pragma once
+// Which integrator a scene renders with, as its <integrator> element says (Mitsuba 3's plugins and
+// defaults; docs/scene-format.md). Plain data: the render settings carry it, make_integrator
+// (integrator/integrator.h) turns it into the object that renders passes.
+#include <string>
+#include <vector>
+
+namespace candela {
+
+enum class IntegratorType {
+    Path,    // path (and volpath in a scene without media): integrator/path/
+    Direct,  // direct: integrator/direct/
+};
+
+// Arbitrary output variables of Mitsuba's `aov` wrapper: values of the first surface the camera
+// ray hits (zero where it hits nothing), filtered into the film like the radiance.
+enum class AovType {
+    Depth,      // distance from the camera's pinhole to the hit: 1 channel ".T"
+    Position,   // world-space hit point: ".X" ".Y" ".Z"
+    GeoNormal,  // geometric normal (world, unit, the triangle's winding side): ".X" ".Y" ".Z"
+    ShNormal,   // shading normal (world, unit, interpolated where the mesh has normals): ".X" ".Y" ".Z"
+    Albedo,     // the BSDF's diffuse reflectance, Mitsuba's eval_diffuse_reflectance: ".R" ".G" ".B"
+};
+
+struct AovSpec {
+    std::string name;  // the <name> of "<name>:<type>"
+    AovType type = AovType::Depth;
+};
+
+struct IntegratorDesc {
+    IntegratorType type = IntegratorType::Path;
+    // Camera rays pass through area emitters (Mitsuba 3's hide_emitters: skip_area_emitters on the
+    // first segment), so that an emitter in view shows what lies behind it.
+    bool hide_emitters = false;
+    // direct: samples per shading point of each strategy, combined by the power heuristic with the
+    // sample counts in the weights (Mitsuba's direct.cpp).
+    int emitter_samples = 1, bsdf_samples = 1;
+    // aov wrapper: the layers written beside the nested integrator's image.
+    std::vector<AovSpec> aovs;
+};
+
+// Number of film channels and their EXR names ("dd.T", "nn.X", ...), in order.
+int aov_channel_count(AovType t);
+int aov_channel_count(const std::vector<AovSpec>& aovs);
+std::vector<std::string> aov_channel_names(const std::vector<AovSpec>& aovs);
+// "depth", "position", ... (Mitsuba's names); false when `s` names no AOV candela computes.
+bool parse_aov_type(const std::string& s, AovType& out);
+
+}  // namespace candela

@@ -1,0 +1,128 @@
+#pragma once
+// Mitsuba 3's `direct` integrator (src/integrators/direct.cpp): emission seen by the camera ray,
+// plus direct lighting at the first surface by `emitter_samples` light samples and `bsdf_samples`
+// BSDF samples, combined by the power heuristic with the sample counts in it:
+//   light sample:  f |cos| Le / p_light * w_l / n_l,   w_l = h(n_l p_light, n_b p_bsdf)
+//   BSDF sample:   f |cos| / p_bsdf * Le * w_b / n_b,   w_b = h(n_b p_bsdf, n_l p_light)
+// with h(a, b) = a^2 / (a^2 + b^2) (0 when not finite), pdfs in solid angle at the shading point,
+// and n_l, n_b the two counts, so that the weights of one direction sum to one over the n_l + n_b
+// samples (Veach's balance of sample counts). Delta lobes: a BSDF-sampled delta direction has no
+// light-sampling density (w_b = 1); light samples are taken only when the BSDF has a smooth part.
+// hide_emitters: the camera ray passes through area emitters (as in the path tracer).
+// Sample order per pixel sample: for each light sample next_1d (which emitter triangle), next_2d
+// (the point); then for each BSDF sample next_1d, next_2d.
+#include "integrator/integrator.h"
+#include "integrator/path.h"
+
+namespace candela {
+
+class DirectIntegrator {
+public:
+    explicit DirectIntegrator(const Scene& scene);
+
+    // Radiance arriving along the camera ray (towards -ray.d). DiffuseOnly as in PathIntegrator.
+    template <class S, bool DiffuseOnly = false>
+    vec3 Li(Ray ray, S& sampler, PathStats& stats) const;
+
+private:
+    // h(a, b) as Mitsuba's mis_weight: a^2 / (a^2 + b^2), 0 when that is not finite.
+    static float mis_weight(float a, float b) {
+        a *= a;
+        b *= b;
+        float w = a / (a + b);
+        return std::isfinite(w) ? w : 0.f;
+    }
+    const Scene& scene_;
+    int n_light_, n_bsdf_;
+    float frac_light_, frac_bsdf_;      // n_l / (n_l + n_b), n_b / (n_l + n_b)
+    float weight_light_, weight_bsdf_;  // 1 / n_l, 1 / n_b
+};
+
+class DirectPass final : public Integrator {
+public:
+    PassStats render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
+                          const std::atomic<bool>* cancel) const override;
+};
+
+inline DirectIntegrator::DirectIntegrator(const Scene& scene) : scene_(scene) {
+    const IntegratorDesc& d = scene.settings.integrator;
+    n_light_ = d.emitter_samples;
+    n_bsdf_ = d.bsdf_samples;
+    const float sum = float(n_light_ + n_bsdf_);
+    frac_light_ = float(n_light_) / sum;
+    frac_bsdf_ = float(n_bsdf_) / sum;
+    weight_light_ = n_light_ > 0 ? 1.f / float(n_light_) : 0.f;
+    weight_bsdf_ = n_bsdf_ > 0 ? 1.f / float(n_bsdf_) : 0.f;
+}
+
+template <class S, bool DiffuseOnly>
+vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
+    const Scene& sc = scene_;
+    Hit hit;
+    ++stats.rays;
+    if (!sc.accel->intersect(ray, hit)) return vec3(0.f);
+    const bool hide = sc.settings.integrator.hide_emitters;
+    if (hide && !skip_area_emitters(sc, ray, hit, stats)) return vec3(0.f);
+    ++stats.camera_hits;  // the film's alpha
+    SurfaceInteraction si = sc.interaction(hit);
+    const vec3 wo_world = -glm::normalize(ray.d);
+    vec3 L(0.f);
+    if (!hide && sc.lights.emitter_of(hit) >= 0) L += sc.lights.emitted(si, wo_world);
+    if (sc.lights.empty()) return L;
+
+    const Material& mat = sc.materials[sc.shapes[si.shape].material];
+    Bsdf textured;
+    const Bsdf& bsdf = mat.textured() ? bsdf_at(mat, sc.texture_query(si, hit), textured) : mat.bsdf;
+    vec3 n = si.ns;
+    if (mat.two_sided && glm::dot(wo_world, n) < 0.f) {
+        n = -n;
+        si.ng = -si.ng;
+    }
+    const Frame frame(n);
+    const vec3 wo = frame.to_local(wo_world);
+
+    if (has_smooth_component_in<DiffuseOnly>(bsdf)) {
+        for (int i = 0; i < n_light_; ++i) {
+            float ul = sampler.next_1d();
+            vec2 up = sampler.next_2d();
+            LightSample ls;
+            if (!sc.lights.sample_li(si.p, ul, up, ls) || !(ls.pdf > 0.f)) continue;
+            const vec3 wi = frame.to_local(ls.wi);
+            const vec3 f = eval_in<DiffuseOnly>(bsdf, wo, wi);
+            if (is_black(f)) continue;
+            Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
+            ++stats.rays;
+            if (sc.accel->occluded(shadow)) continue;
+            const float bsdf_pdf = pdf_in<DiffuseOnly>(bsdf, wo, wi);
+            const float w = mis_weight(ls.pdf * frac_light_, bsdf_pdf * frac_bsdf_) * weight_light_;
+            L += f * ls.Le * (w / ls.pdf);
+        }
+    } else {
+        for (int i = 0; i < n_light_; ++i) {  // keep the sample dimensions aligned
+            sampler.next_1d();
+            sampler.next_2d();
+        }
+    }
+
+    for (int i = 0; i < n_bsdf_; ++i) {
+        float u1 = sampler.next_1d();
+        vec2 u2 = sampler.next_2d();
+        std::optional<BsdfSample> bs = sample_in<DiffuseOnly>(bsdf, wo, u1, u2);
+        if (!bs || !(bs->pdf > 0.f)) continue;
+        const vec3 beta = bs->weight();
+        if (is_black(beta)) continue;
+        Ray r = spawn_ray(si, frame.to_world(bs->wi));
+        Hit h;
+        ++stats.rays;
+        if (!sc.accel->intersect(r, h) || sc.lights.emitter_of(h) < 0) continue;
+        const SurfaceInteraction se = sc.interaction(h);
+        const vec3 Le = sc.lights.emitted(se, -glm::normalize(r.d));
+        if (is_black(Le)) continue;
+        const float light_pdf = bs->delta ? 0.f : sc.lights.pdf_li(si.p, se);
+        const float w = mis_weight(bs->pdf * frac_bsdf_, light_pdf * frac_light_) * weight_bsdf_;
+        L += beta * Le * w;
+    }
+    return L;
+}
+
+}  // namespace candela

@@ -1,0 +1,23 @@
+#include "integrator/integrator.h"
+#include "integrator/direct/direct.h"
+#include "integrator/path/path_pass.h"
+
+namespace candela {
+
+std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
+    switch (scene.settings.integrator.type) {
+        case IntegratorType::Direct: return std::make_unique<DirectPass>();
+        case IntegratorType::Path: break;
+    }
+    return std::make_unique<PathPass>();
+}
+
+bool film_fits(const Film& film, const RenderSettings& st) {
+    return film.weighted() == !st.filter.is_box() && film.aov_channels() == aov_channel_count(st.integrator.aovs);
+}
+
+void configure_film(Film& film, const RenderSettings& st) {
+    if (!film_fits(film, st)) film.set_layout(!st.filter.is_box(), aov_channel_count(st.integrator.aovs));
+}
+
+}  // namespace candela

@@ -1,0 +1,179 @@
+#pragma once
+// The tile loop every integrator's pass runs: 16 x 16 tiles shared out to OpenMP threads
+// dynamically, each pixel sample seeded from (pixel, sample index, seed), its camera ray jittered
+// uniformly in the pixel, its radiance estimated by `li` and added to the film.
+//
+//   li(IndependentSampler& sampler, Ray camera_ray, PathStats& stats) -> vec3 radiance
+//
+// Box filter (the film unweighted): each sample goes to its own pixel, which only its tile
+// writes, in sample order: the plain loop of before, at its speed.
+// Other filters (the film weighted): a sample splats into every pixel within the filter's radius,
+// also across tiles. Each tile accumulates into its own FilmTile (the tile plus the filter's
+// reach), and after all tiles the FilmTiles are merged into the film in tile order. The pass runs
+// one sample index at a time (all tiles for index s, merge, then s + 1), so the additions into a
+// pixel happen in the order (sample index, tile, pixel), whatever the thread count and whatever
+// the split of the samples into passes: the image is the same bit for bit.
+// AOVs (the aov wrapper): computed for the camera ray before `li` runs, filtered the same way.
+#include <omp.h>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+#include "film/filter.h"
+#include "integrator/aov/aov.h"
+#include "integrator/integrator.h"
+#include "integrator/path.h"
+#include "sampling/sampler.h"
+
+namespace candela {
+
+constexpr int kTileSize = 16;
+
+namespace detail {
+
+// Mitsuba's ImageBlock::put (scalar, non-coalesced): the pixels whose centres lie within the radius
+// of `pos`, with separable discretised weights evaluated in float.
+inline void splat(FilmTile& t, const PixelFilter& f, int film_w, int film_h, vec2 pos, vec3 L, const float* aov,
+                  bool covered = false) {
+    constexpr int kMax = 2 * 64 + 2;  // the XML reader caps radii at 64 pixels
+    const float r = f.radius();
+    const vec2 pf = pos - 0.5f;  // pixel centres are at integers + 0.5
+    const int lo_x = std::max(int(std::ceil(pf.x - r)), std::max(0, t.x0));
+    const int hi_x = std::min(int(std::floor(pf.x + r)), std::min(film_w, t.x0 + t.width) - 1);
+    const int lo_y = std::max(int(std::ceil(pf.y - r)), std::max(0, t.y0));
+    const int hi_y = std::min(int(std::floor(pf.y + r)), std::min(film_h, t.y0 + t.height) - 1);
+    if (lo_x > hi_x || lo_y > hi_y) return;
+    float wx[kMax], wy[kMax];
+    const int nx = std::min(hi_x - lo_x + 1, kMax), ny = std::min(hi_y - lo_y + 1, kMax);
+    float rx = float(lo_x) - pf.x, ry = float(lo_y) - pf.y;
+    for (int i = 0; i < nx; ++i, rx += 1.f) wx[i] = f.eval_discretized(rx);
+    for (int i = 0; i < ny; ++i, ry += 1.f) wy[i] = f.eval_discretized(ry);
+    const dvec3 Ld(L);
+    const int nc = t.aov_channels;
+    for (int y = 0; y < ny; ++y) {
+        size_t j = size_t(lo_y + y - t.y0) * size_t(t.width) + size_t(lo_x - t.x0);
+        for (int x = 0; x < nx; ++x, ++j) {
+            const double w = double(wx[x] * wy[y]);
+            t.sum[j] += Ld * w;
+            t.weight[j] += w;
+            if (!t.alpha.empty() && covered) t.alpha[j] += w;
+            for (int k = 0; k < nc; ++k) t.aov[j * size_t(nc) + size_t(k)] += double(aov[k]) * w;
+        }
+    }
+}
+
+struct TileRange {
+    int x0, y0, x1, y1;
+};
+inline TileRange tile_range(int tile, int tiles_x, int w, int h) {
+    const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+    return {x0, y0, std::min(x0 + kTileSize, w), std::min(y0 + kTileSize, h)};
+}
+
+}  // namespace detail
+
+template <class Li>
+PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
+                       const std::atomic<bool>* cancel, const Li& li) {
+    const int w = film.width(), h = film.height();
+    const int tiles_x = (w + kTileSize - 1) / kTileSize;
+    const int tiles_y = (h + kTileSize - 1) / kTileSize;
+    const int n_tiles = tiles_x * tiles_y;
+    // The scene's camera for this film: a preview renders the same view at a smaller size.
+    Camera camera = scene.camera;
+    camera.set_film_size(w, h);
+    const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
+    const int n_aov = film.aov_channels();
+    const vec3 eye = camera.origin();
+    const bool alpha = film.has_alpha();
+    std::atomic<uint64_t> total_rays{0}, total_samples{0};
+    std::atomic<bool> stopped{false};
+    auto cancelled = [&] {
+        if (stopped.load(std::memory_order_relaxed)) return true;
+        if (cancel && cancel->load(std::memory_order_relaxed)) {
+            stopped = true;
+            return true;
+        }
+        return false;
+    };
+
+    if (!film.weighted()) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+        for (int tile = 0; tile < n_tiles; ++tile) {
+            if (cancelled()) continue;
+            IndependentSampler sampler(scene.settings.seed);
+            PathStats ps;
+            uint64_t samples = 0;
+            float aov[64];
+            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
+            for (int y = tr.y0; y < tr.y1; ++y)
+                for (int x = tr.x0; x < tr.x1; ++x) {
+                    for (int s = 0; s < spp; ++s) {
+                        // Sampler dimensions of a camera sample: the pixel jitter (2), the lens (2, a
+                        // thin lens with an aperture only), then the integrator's.
+                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
+                        vec2 jitter = sampler.next_2d();  // uniform over the pixel
+                        vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                        if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
+                        const uint64_t hits = ps.camera_hits;
+                        vec3 L = li(sampler, ray, ps);
+                        film.add_sample(ivec2(x, y), L);
+                        if (alpha) film.add_coverage(ivec2(x, y), ps.camera_hits != hits);
+                        if (n_aov > 0) film.add_aov(ivec2(x, y), aov);
+                        ++samples;
+                    }
+                }
+            total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
+            total_samples.fetch_add(samples, std::memory_order_relaxed);
+        }
+    } else {
+        const PixelFilter filter(scene.settings.filter);
+        std::vector<FilmTile> tiles(static_cast<size_t>(n_tiles));
+        std::vector<char> done(static_cast<size_t>(n_tiles));
+        for (int s = 0; s < spp && !cancelled(); ++s) {
+            std::fill(done.begin(), done.end(), 0);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+            for (int tile = 0; tile < n_tiles; ++tile) {
+                if (cancelled()) continue;
+                IndependentSampler sampler(scene.settings.seed);
+                PathStats ps;
+                uint64_t samples = 0;
+                float aov[64];
+                const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
+                FilmTile& ft = tiles[size_t(tile)];
+                ft.reset(film, tr.x0, tr.y0, tr.x1, tr.y1, filter.reach());
+                for (int y = tr.y0; y < tr.y1; ++y)
+                    for (int x = tr.x0; x < tr.x1; ++x) {
+                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
+                        const vec2 jitter = sampler.next_2d();
+                        const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                        // The filter works in this film's pixels (a crop window only shifts them).
+                        const vec2 pos = vec2(float(x), float(y)) + jitter;
+                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                        if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
+                        const uint64_t hits = ps.camera_hits;
+                        vec3 L = li(sampler, ray, ps);
+                        if (!all_finite(L)) {
+                            film.count_nonfinite();
+                            L = vec3(0.f);
+                        }
+                        film.count_sample(ivec2(x, y));
+                        detail::splat(ft, filter, w, h, pos, L, aov, ps.camera_hits != hits);
+                        ++samples;
+                    }
+                done[size_t(tile)] = 1;
+                total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
+                total_samples.fetch_add(samples, std::memory_order_relaxed);
+            }
+            for (int tile = 0; tile < n_tiles; ++tile)
+                if (done[size_t(tile)]) film.merge(tiles[size_t(tile)]);
+        }
+    }
+    PassStats out;
+    out.rays = total_rays.load();
+    out.samples = total_samples.load();
+    out.completed = !stopped.load();
+    return out;
+}
+
+}  // namespace candela

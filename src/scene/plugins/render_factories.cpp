@@ -1,0 +1,127 @@
+#include "scene/plugins/render_factories.h"
+#include <sstream>
+
+namespace candela {
+
+namespace {
+
+// path, volpath: Mitsuba's MonteCarloIntegrator parameters. Mitsuba's max_depth counts path
+// segments, candela's scattering events.
+void read_depths(const ParamSet& p, RenderSettings& st) {
+    int max_depth = p.get_int("max_depth", -1);
+    int rr_depth = p.get_int("rr_depth", 5);
+    if (max_depth < -1) throw p.error("max_depth", "max_depth must be -1 (unbounded) or positive");
+    // A Mitsuba depth of 0 renders black; that is never what a user wants, so it is rejected.
+    if (max_depth == 0) throw p.error("max_depth", "max_depth 0 renders a black image; use -1 or a value >= 1");
+    if (rr_depth <= 0) throw p.error("rr_depth", "rr_depth must be greater than zero");
+    st.max_depth = max_depth < 0 ? -1 : max_depth - 1;
+    st.rr_depth = rr_depth;
+}
+
+int sample_count(const ParamSet& p, const std::string& name, int def) {
+    int n = p.get_int(name, def);
+    if (n < 0 || n > 1 << 16) throw p.error(name, name + " must be in [0, 65536]");
+    return n;
+}
+
+std::vector<AovSpec> parse_aovs(const ParamSet& p) {
+    if (!p.has("aovs")) throw p.error("aovs", "integrator 'aov' needs an 'aovs' string (\"name:type,...\")");
+    std::string text = p.get_string("aovs", "");
+    std::vector<AovSpec> out;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        // Mitsuba's string::tokenize drops white space around items.
+        const size_t b = item.find_first_not_of(" \t\n"), e = item.find_last_not_of(" \t\n");
+        item = b == std::string::npos ? std::string() : item.substr(b, e - b + 1);
+        if (item.empty()) continue;
+        const size_t colon = item.find(':');
+        if (colon == std::string::npos || colon == 0 || colon + 1 == item.size() ||
+            item.find(':', colon + 1) != std::string::npos)
+            throw p.error("aovs", "invalid AOV '" + item + "': expected <name>:<type>");
+        AovSpec a;
+        a.name = item.substr(0, colon);
+        const std::string type = item.substr(colon + 1);
+        if (!parse_aov_type(type, a.type)) {
+            const bool mitsuba = type == "uv" || type == "dp_du" || type == "dp_dv" || type == "duv_dx" ||
+                                 type == "duv_dy" || type == "prim_index" || type == "shape_index" ||
+                                 type == "boundary_test";
+            throw p.error("aovs", "AOV type '" + type + "' " +
+                                      (mitsuba ? "is not supported (candela's surfaces carry no uv parameterisation yet)"
+                                               : "is unknown") +
+                                      "; candela writes depth, position, sh_normal, geo_normal, albedo");
+        }
+        out.push_back(a);
+    }
+    if (out.empty()) throw p.error("aovs", "no AOVs in '" + text + "'");
+    if (aov_channel_count(out) > 64) throw p.error("aovs", "more than 64 AOV channels");
+    return out;
+}
+
+}  // namespace
+
+IntegratorRole read_integrator(const std::string& type, const ParamSet& p, RenderSettings& st, int line) {
+    IntegratorDesc& d = st.integrator;
+    if (type == "path" || type == "volpath") {
+        // volpath is the path tracer in a scene without media; candela reads no <medium>, so a
+        // scene with one fails at that element.
+        read_depths(p, st);
+        d.type = IntegratorType::Path;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
+    if (type == "direct") {
+        if (p.has("shading_samples") && (p.has("emitter_samples") || p.has("bsdf_samples")))
+            throw p.error("shading_samples", "cannot give both 'shading_samples' and 'emitter_samples'/'bsdf_samples'");
+        int shading = sample_count(p, "shading_samples", 1);
+        d.type = IntegratorType::Direct;
+        d.emitter_samples = sample_count(p, "emitter_samples", shading);
+        d.bsdf_samples = sample_count(p, "bsdf_samples", shading);
+        if (d.emitter_samples + d.bsdf_samples == 0)
+            throw p.error(p.has("bsdf_samples") ? "bsdf_samples" : "shading_samples",
+                          "direct needs at least one BSDF or emitter sample");
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        // The direct integrator has no depth: it is one scattering event.
+        st.max_depth = 1;
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
+    if (type == "moment") {
+        // The image is the nested integrator's; Mitsuba adds its second moment as extra AOV
+        // channels, which candela does not write.
+        p.report_unused();
+        return IntegratorRole::Wraps;
+    }
+    if (type == "aov") {
+        if (!d.aovs.empty()) throw p.error("aovs", "an aov integrator inside another aov integrator");
+        d.aovs = parse_aovs(p);
+        p.report_unused();
+        return IntegratorRole::Wraps;
+    }
+    throw Error(p.file(), line, "unsupported integrator type '" + type +
+                "' (candela supports: path, volpath, direct, moment, aov)");
+}
+
+FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {
+    FilterDesc f;
+    if (type == "box") {
+        f = box_filter();  // Mitsuba's box has no parameters: radius 0.5
+    } else if (type == "tent") {
+        float r = p.get_float("radius", 1.f);
+        if (!(r > 0.f && r <= 64.f)) throw p.error("radius", "tent radius must be in (0, 64] pixels");
+        // Mitsuba's image block takes any filter of radius 0.5 for the box (is_box_filter).
+        f = r == 0.5f ? box_filter() : tent_filter(r);
+    } else if (type == "gaussian") {
+        float s = p.get_float("stddev", 0.5f);
+        if (!(s > 0.f && s <= 16.f)) throw p.error("stddev", "gaussian stddev must be in (0, 16] pixels");
+        f = 4.f * s == 0.5f ? box_filter() : gaussian_filter(s);
+    } else {
+        throw Error(p.file(), line, "unsupported rfilter type '" + type +
+                    "' (candela supports: box, tent, gaussian)");
+    }
+    p.report_unused();
+    return f;
+}
+
+}  // namespace candela
