@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 #include "core/error.h"
+#include "accel/instances.h"
 #include "accel/with_analytic.h"
 #include "film/film.h"
 
@@ -89,6 +90,8 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       mesh(geometry->mesh),
       shapes(geometry->shapes),
       analytic(geometry->analytic),
+      groups(geometry->groups),
+      instances(geometry->instances),
       accel(std::move(accel_)),
       light_set(std::move(lights_)),
       lights(*light_set),
@@ -107,6 +110,18 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
             throw Error(desc.source, 0, "triangle index out of range");
     if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
+    for (ShapeGroup& g : desc.groups) {
+        for (const vec3& p : g.mesh.positions)
+            if (!all_finite(p)) throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite vertex");
+        for (const uvec3& t : g.mesh.triangles)
+            if (t.x >= g.mesh.positions.size() || t.y >= g.mesh.positions.size() || t.z >= g.mesh.positions.size())
+                throw Error(desc.source, 0, "shapegroup '" + g.id + "': triangle index out of range");
+        if (!g.mesh.normals.empty()) g.mesh.normals.resize(g.mesh.positions.size(), vec3(0.f));
+    }
+    for (Instance& in : desc.instances) {
+        if (in.group >= desc.groups.size()) throw Error(desc.source, 0, "instance of an unknown shapegroup");
+        in.bounds = transform_box(in.to_world, desc.groups[in.group].bounds());
+    }
     SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters)};
     check_params(desc.source, desc.shapes, params);
 
@@ -114,13 +129,22 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     geometry->mesh = std::move(desc.mesh);
     geometry->shapes = std::move(desc.shapes);
     geometry->analytic = std::move(desc.analytic);
+    geometry->groups = std::move(desc.groups);
+    geometry->instances = std::move(desc.instances);
     geometry->bounds = geometry->mesh.bounds();
     for (const AnalyticShape& a : geometry->analytic) geometry->bounds.expand(a.bounds());
+    for (const Instance& in : geometry->instances) geometry->bounds.expand(in.bounds);
     std::unique_ptr<Accel> tri_accel = make_accel(accel_name, geometry->mesh);
-    // Only a scene with analytic shapes pays for querying them.
-    std::shared_ptr<const Accel> accel =
-        geometry->analytic.empty() ? std::shared_ptr<const Accel>(std::move(tri_accel))
-                                   : std::make_shared<WithAnalyticAccel>(std::move(tri_accel), geometry->analytic);
+    // Only a scene with analytic shapes pays for querying them, and only one with instances for
+    // the instance level.
+    if (!geometry->analytic.empty())
+        tri_accel = std::make_unique<WithAnalyticAccel>(std::move(tri_accel), geometry->analytic);
+    if (!geometry->instances.empty()) {
+        bool own = !geometry->mesh.triangles.empty() || !geometry->analytic.empty();
+        tri_accel = std::make_unique<InstanceAccel>(own ? std::move(tri_accel) : nullptr, geometry->groups,
+                                                    geometry->instances, accel_name);
+    }
+    std::shared_ptr<const Accel> accel(std::move(tri_accel));
     auto lights = std::make_shared<LightSet>();
     lights->build(geometry->mesh, geometry->shapes, params.emitters, &geometry->analytic);
     return std::shared_ptr<const Scene>(
@@ -139,8 +163,9 @@ std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     return std::shared_ptr<const Scene>(new Scene(source, geometry, accel, std::move(lights_for), p, warnings));
 }
 
-SurfaceInteraction Scene::interaction(const Hit& hit) const {
-    if (__builtin_expect(hit.kind != PrimKind::Triangle, 0)) return analytic_interaction(analytic[hit.prim], hit);
+namespace {
+
+SurfaceInteraction triangle_interaction(const Mesh& mesh, const std::vector<Shape>& shapes, const Hit& hit) {
     SurfaceInteraction si;
     si.prim = hit.prim;
     si.shape = mesh.tri_shape[hit.prim];
@@ -161,11 +186,45 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
     return si;
 }
 
+vec3 transform_normal(const glm::mat3& inv_t, vec3 n) {
+    vec3 w = inv_t * n;
+    float l2 = glm::dot(w, w);
+    return l2 > 0.f && std::isfinite(l2) ? w / std::sqrt(l2) : n;
+}
+
+}  // namespace
+
+SurfaceInteraction Scene::interaction(const Hit& hit) const {
+    // One test for both rare cases: an analytic shape (kind != 0) or an instance (instance != ~0u).
+    if (__builtin_expect((uint32_t(hit.kind) | (hit.instance + 1u)) != 0u, 0)) {
+        if (hit.instance == ~0u) return analytic_interaction(analytic[hit.prim], hit);
+        const Instance& in = instances[hit.instance];
+        const ShapeGroup& g = groups[in.group];
+        SurfaceInteraction si = hit.kind == PrimKind::Triangle ? triangle_interaction(g.mesh, shapes, hit)
+                                                               : analytic_interaction(g.analytic[hit.prim], hit);
+        si.p = transform_point_error(in.to_world, si.p, si.p_error, &si.p_error);
+        glm::mat3 inv_t = glm::transpose(glm::mat3(in.to_object));
+        si.ng = transform_normal(inv_t, si.ng);
+        si.ns = transform_normal(inv_t, si.ns);
+        si.instance = hit.instance;
+        return si;
+    }
+    return triangle_interaction(mesh, shapes, hit);
+}
+
 Scene::Memory Scene::memory() const {
     Memory m;
     m.triangles = mesh.triangles.size();
     m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
              mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t);
+    m.instances = instances.size();
+    for (const ShapeGroup& g : groups) {
+        m.triangles += g.mesh.triangles.size();
+        m.mesh += g.mesh.positions.capacity() * sizeof(vec3) + g.mesh.normals.capacity() * sizeof(vec3) +
+                  g.mesh.triangles.capacity() * sizeof(uvec3) + g.mesh.tri_shape.capacity() * sizeof(uint32_t) +
+                  g.analytic.capacity() * sizeof(AnalyticShape);
+    }
+    m.mesh += instances.capacity() * sizeof(Instance);
     m.accel = accel ? accel->memory_bytes() : 0;
     m.lights = lights.memory_bytes();
     return m;

@@ -16,6 +16,7 @@
 #include "accel/accel.h"
 #include "bsdf/bsdf.h"
 #include "geometry/analytic.h"
+#include "geometry/instance.h"
 #include "geometry/mesh.h"
 #include "light/area.h"
 #include "scene/camera.h"
@@ -50,6 +51,8 @@ struct SceneDescription {
     Mesh mesh;
     std::vector<Shape> shapes;
     std::vector<AnalyticShape> analytic;  // spheres, disks, cylinders (Shape::analytic indexes it)
+    std::vector<ShapeGroup> groups;       // shapegroups (Shape::group indexes it), seen only through
+    std::vector<Instance> instances;      // instances (Instance::group indexes groups)
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
     Camera camera;
@@ -68,7 +71,9 @@ struct Geometry {
     Mesh mesh;
     std::vector<Shape> shapes;
     std::vector<AnalyticShape> analytic;
-    AABB bounds;
+    std::vector<ShapeGroup> groups;
+    std::vector<Instance> instances;
+    AABB bounds;  // world: the scene's own primitives and every instance
 };
 
 class Scene {
@@ -80,6 +85,8 @@ public:
     const Mesh& mesh;                  // geometry->mesh
     const std::vector<Shape>& shapes;  // geometry->shapes
     const std::vector<AnalyticShape>& analytic;  // geometry->analytic
+    const std::vector<ShapeGroup>& groups;       // geometry->groups
+    const std::vector<Instance>& instances;      // geometry->instances
     const std::shared_ptr<const Accel> accel;
     const std::shared_ptr<const LightSet> light_set;
     const LightSet& lights;            // *light_set
@@ -104,14 +111,18 @@ public:
     SceneParams params() const { return {camera, settings, materials, emitters}; }
 
     // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
-    // of the point.
+    // of the point. In an instance (hit.instance set) the group-space interaction is taken to
+    // world space: p by to_world with its error bound carried through the transform (pbrt-v4
+    // Point3fi), ng and ns by the inverse transpose and renormalised (as Mitsuba's Instance: a
+    // mirroring to_world does not turn them around), uv unchanged.
     SurfaceInteraction interaction(const Hit& hit) const;
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.
     struct Memory {
-        size_t triangles = 0;
-        size_t mesh = 0, accel = 0, lights = 0;  // bytes
+        size_t triangles = 0;   // stored: the scene's own plus each group's once
+        size_t instances = 0;
+        size_t mesh = 0, accel = 0, lights = 0;  // bytes (mesh: every stored mesh, plus the instances)
         size_t total() const { return mesh + accel + lights; }
     };
     Memory memory() const;
