@@ -276,3 +276,29 @@ TEST(Instancing, DISABLED_MitsubaAgreementDetectsDimmerLight) {
     std::printf("  light 5%% dimmer: blocks %s\n", r.describe().c_str());
     EXPECT_FALSE(r.passed(kAlpha));
 }
+
+// Pick reports the instance hit, with the point and normal in world space.
+#include "viewer/pick.h"
+
+TEST(Instancing, PickKnowsInstances) {
+    auto scene_with = [](float x) {
+        std::string body = "<shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\"/></shape>\n"
+                           "<shape type=\"instance\"><ref id=\"g\"/></shape>\n"
+                           "<shape type=\"instance\"><ref id=\"g\"/><transform name=\"to_world\"><translate x=\"" +
+                           std::to_string(x) + "\"/></transform></shape>\n"
+                           "<sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0, 0, 10\" "
+                           "target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>\n";
+        return build_scene(load_scene(write_xml("fp" + std::to_string(int(x)) + ".xml", body)));
+    };
+    auto a = scene_with(3.f);
+    Camera cam = a->camera;
+    cam.set_film_size(64, 64);
+    PickResult centre = pick(*a, cam, vec2(32.f, 32.f));
+    ASSERT_TRUE(centre.hit);
+    EXPECT_EQ(centre.instance, 0u);
+    EXPECT_EQ(centre.kind, PrimKind::Sphere);
+    EXPECT_NEAR(centre.position.z, 1.f, 1e-4f);  // the unit sphere's front, in world space
+    EXPECT_NEAR(centre.normal.z, 1.f, 1e-4f);
+    PickResult corner = pick(*a, cam, vec2(1.f, 1.f));
+    EXPECT_FALSE(corner.hit);
+}
