@@ -146,7 +146,7 @@ TEST(BadInput, XmlTagsAttributesPluginsAndRefs) {
     };
     check("<shape type=\"cube\">\n<sphere/></shape>\n", 3, "unknown tag <sphere>");
     check("\n<shape type=\"cube\" colour=\"red\"/>\n", 3, "unexpected attribute 'colour'");
-    check("<shape type=\"cube\"/>\n\n<shape type=\"ply\"/>\n", 4, "unsupported shape type 'ply'");
+    check("<shape type=\"cube\"/>\n\n<shape type=\"bsplinecurve\"/>\n", 4, "unsupported shape type 'bsplinecurve'");
     check("<bsdf type=\"velvet\" id=\"v\"/>\n", 2, "unsupported bsdf type 'velvet'");
     check("<sensor type=\"perspective\">\n<flaot name=\"fov\" value=\"30\"/></sensor>\n", 3, "unknown tag <flaot>");
     check("<sensor type=\"perspective\">\n<float name=\"fvo\" value=\"30\"/></sensor>\n", 3, "unused parameter 'fvo'");

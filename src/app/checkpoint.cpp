@@ -75,9 +75,10 @@ static_assert(sizeof(vec3) == 12 && sizeof(uvec3) == 12 && sizeof(dvec3) == 24, 
 // ---- the file format -----------------------------------------------------------------------------
 // Native byte order (x86-64 and ARM64 are both little-endian; a marker catches any other):
 //   0  char[8]  magic "CNDLCKPT"      8  u32 version          12 u32 header size (64)
-//   16 i32 width                      20 i32 height           24 u32 spp        28 u32 zero
+//   16 i32 width                      20 i32 height           24 u32 spp        28 u32 flags (1: alpha)
 //   32 u64 non-finite samples         40 u64 fingerprint      48 u64 pixels     56 u64 byte-order marker
-//   64 pixels x 3 f64 sums, then pixels x u32 counts, then u64 hash of everything before it.
+//   64 pixels x 3 f64 sums, then pixels x u32 counts, then (flag alpha) pixels x f64 alpha sums,
+//   then u64 hash of everything before it.
 constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderSize = 64;
@@ -175,6 +176,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.i64(st.width);
     h.i64(st.height);
     h.u64(st.seed);
+    h.u64(st.alpha);
     h.i64(st.max_depth);
     h.i64(st.rr_depth);
     h.i64(int(st.sampling));
@@ -185,6 +187,15 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.bytes(m.positions.data(), m.positions.size() * sizeof(vec3));
     h.u64(m.normals.size());
     h.bytes(m.normals.data(), m.normals.size() * sizeof(vec3));
+    // uvs and colours only when present, so that scenes without them keep their fingerprint.
+    if (!m.uvs.empty()) {
+        h.str("uvs");
+        h.bytes(m.uvs.data(), m.uvs.size() * sizeof(vec2));
+    }
+    if (!m.colors.empty()) {
+        h.str("colors");
+        h.bytes(m.colors.data(), m.colors.size() * sizeof(vec3));
+    }
     h.u64(m.triangles.size());
     h.bytes(m.triangles.data(), m.triangles.size() * sizeof(uvec3));
     h.bytes(m.tri_shape.data(), m.tri_shape.size() * sizeof(uint32_t));
@@ -195,6 +206,11 @@ uint64_t scene_fingerprint(const Scene& scene) {
         h.u64(s.smooth);
         h.u64(s.first_triangle);
         h.u64(s.triangle_count);
+        if (s.has_uv() || s.has_color()) {  // only then, so that other scenes keep their fingerprint
+            h.u64(s.first_vertex);
+            h.u64(s.uv_offset);
+            h.u64(s.color_offset);
+        }
     }
     // Analytic shapes (only when there are some: a scene of triangles keeps its fingerprint).
     if (!scene.analytic.empty()) {
@@ -226,6 +242,10 @@ uint64_t scene_fingerprint(const Scene& scene) {
             h.u64(gm.triangles.size());
             h.bytes(gm.triangles.data(), gm.triangles.size() * sizeof(uvec3));
             h.bytes(gm.tri_shape.data(), gm.tri_shape.size() * sizeof(uint32_t));
+            h.u64(gm.uvs.size());
+            h.bytes(gm.uvs.data(), gm.uvs.size() * sizeof(vec2));
+            h.u64(gm.colors.size());
+            h.bytes(gm.colors.data(), gm.colors.size() * sizeof(vec3));
             h.u64(g.analytic.size());
             for (const AnalyticShape& a : g.analytic) {
                 h.u64(uint64_t(a.kind));
@@ -274,16 +294,25 @@ uint64_t scene_fingerprint(const Scene& scene) {
         }
     }
 
-    // The camera is probed by its rays, which depend on every camera parameter and the film size.
+    // The camera is probed by its rays, which depend on every camera parameter (type, fov, clip
+    // planes, principal point, aperture through off-centre lens samples, focus distance, full
+    // film and crop window) and the image size; the crop offset also moves the sampler's pixels.
+    const Camera& cam = scene.camera;
+    h.u64(uint64_t(cam.type));
+    h.u64(cam.needs_lens_sample());
+    const ivec2 seed_px = cam.sampler_pixel(ivec2(0));
+    h.u64(uint64_t(uint32_t(seed_px.x)) << 32 | uint32_t(seed_px.y));
     const float fx[] = {0.f, 0.31f, 0.5f, 1.f}, fy[] = {0.f, 0.77f, 0.5f, 1.f};
+    const vec2 lens[] = {vec2(0.5f), vec2(0.13f, 0.71f), vec2(0.9f, 0.35f)};
     for (float x : fx)
-        for (float y : fy) {
-            Ray r = scene.camera.generate_ray(vec2(x * float(st.width), y * float(st.height)));
-            h.v3(r.o);
-            h.v3(r.d);
-            h.f32(r.tmin);
-            h.f32(r.tmax);
-        }
+        for (float y : fy)
+            for (vec2 l : lens) {
+                Ray r = cam.generate_ray(ivec2(0), vec2(x * float(st.width), y * float(st.height)), l);
+                h.v3(r.o);
+                h.v3(r.d);
+                h.f32(r.tmin);
+                h.f32(r.tmax);
+            }
     return h.digest();
 }
 
@@ -300,6 +329,7 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     put<int32_t>(header, 16, film.width());
     put<int32_t>(header, 20, film.height());
     put<uint32_t>(header, 24, spp);
+    put<uint32_t>(header, 28, film.has_alpha() ? 1u : 0u);
     put<uint64_t>(header, 32, film.nonfinite_count());
     put<uint64_t>(header, 40, fingerprint);
     put<uint64_t>(header, 48, uint64_t(sums.size()));
@@ -309,6 +339,7 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     w.write(header, kHeaderSize);
     w.write(sums.data(), sums.size() * sizeof(dvec3));
     w.write(counts.data(), counts.size() * sizeof(uint32_t));
+    if (film.has_alpha()) w.write(film.alpha_sums().data(), film.alpha_sums().size() * sizeof(double));
     uint64_t check = w.hash();
     w.write(&check, sizeof check);
     w.commit();
@@ -343,7 +374,13 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
     if (info.width <= 0 || info.height <= 0 || info.width > (1 << 20) || info.height > (1 << 20) ||
         pixels != uint64_t(info.width) * uint64_t(info.height))
         throw Error(path, 0, "corrupt checkpoint (bad image size)");
-    const uint64_t expected = kHeaderSize + pixels * kBytesPerPixel + 8;
+    const uint32_t flags = get<uint32_t>(header, 28);
+    if (flags > 1) throw Error(path, 0, "corrupt checkpoint (unknown flags)");
+    const bool alpha = flags == 1;
+    if (alpha != film.has_alpha())
+        throw Error(path, 0, std::string("checkpoint ") + (alpha ? "has" : "has no") + " alpha channel, this render " +
+                                 (film.has_alpha() ? "has one" : "has none") + "; refusing to resume");
+    const uint64_t expected = kHeaderSize + pixels * (kBytesPerPixel + (alpha ? sizeof(double) : 0)) + 8;
     if (file_size != expected)
         throw Error(path, 0, "truncated or corrupt checkpoint (" + std::to_string(file_size) + " bytes, expected " +
                                  std::to_string(expected) + ")");
@@ -359,12 +396,15 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
     std::vector<uint32_t> counts(static_cast<size_t>(pixels));
     read_exact(f.get(), sums.data(), sums.size() * sizeof(dvec3), path);
     read_exact(f.get(), counts.data(), counts.size() * sizeof(uint32_t), path);
+    std::vector<double> alpha_sums(alpha ? static_cast<size_t>(pixels) : 0);
+    if (alpha) read_exact(f.get(), alpha_sums.data(), alpha_sums.size() * sizeof(double), path);
     uint64_t stored = 0;
     read_exact(f.get(), &stored, sizeof stored, path);
     Hasher h;
     h.bytes(header, kHeaderSize);
     h.bytes(sums.data(), sums.size() * sizeof(dvec3));
     h.bytes(counts.data(), counts.size() * sizeof(uint32_t));
+    if (alpha) h.bytes(alpha_sums.data(), alpha_sums.size() * sizeof(double));
     if (h.digest() != stored) throw Error(path, 0, "corrupt checkpoint (checksum mismatch)");
     // Whole passes only, and sums the film could have made (non-finite samples never enter them).
     for (uint32_t c : counts)
@@ -373,7 +413,11 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z))
             throw Error(path, 0, "corrupt checkpoint (non-finite sum)");
     if (info.nonfinite > pixels * uint64_t(info.spp)) throw Error(path, 0, "corrupt checkpoint (non-finite count)");
+    for (size_t i = 0; i < alpha_sums.size(); ++i)
+        if (!(alpha_sums[i] >= 0.0 && alpha_sums[i] <= double(info.spp)))
+            throw Error(path, 0, "corrupt checkpoint (alpha out of range)");
     film.restore(std::move(sums), std::move(counts), info.nonfinite);
+    if (alpha) film.restore_alpha(std::move(alpha_sums));
     return info;
 }
 

@@ -135,6 +135,7 @@ int run_headless(const HeadlessOptions& opt) {
     if (target > std::numeric_limits<uint32_t>::max())
         throw Error("--frames x --spp-per-frame is " + std::to_string(target) + " samples per pixel, more than 2^32 - 1");
     Film film(st.width, st.height);
+    if (st.alpha) film.enable_alpha();
     int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
 
     const bool checkpointing = !opt.checkpoint.empty();
@@ -227,7 +228,8 @@ int run_headless(const HeadlessOptions& opt) {
     }
     if (checkpointing && whole_passes) save("final");
 
-    Image img{film.width(), film.height(), film.resolve()};
+    Image img{film.width(), film.height(), film.resolve(), {}};
+    if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
     std::string written = opt.out;
     bool png_failed = false;
     if (ext == ".png") {
@@ -238,6 +240,7 @@ int run_headless(const HeadlessOptions& opt) {
             png_failed = true;
             written = std::filesystem::path(opt.out).replace_extension(".exr").string();
             std::fprintf(stderr, "candela: %s\n", e.what());
+            if (film.has_alpha()) img.alpha = film.resolve_alpha();
             write_linear_image(written, img);
             std::fprintf(stderr, "candela: %s not written; the image is in %s (linear EXR) instead\n",
                          opt.out.c_str(), written.c_str());

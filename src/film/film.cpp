@@ -9,7 +9,30 @@ void Film::resize(int width, int height) {
     sum_.assign(size_t(width) * size_t(height), dvec3(0.0));
     count_.assign(size_t(width) * size_t(height), 0u);
     splat_.clear();
+    if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
     nonfinite_ = 0;
+}
+
+void Film::enable_alpha() {
+    alpha_enabled_ = true;
+    alpha_.assign(sum_.size(), 0.0);
+}
+
+float Film::alpha(int x, int y) const {
+    size_t i = size_t(y) * size_t(width_) + size_t(x);
+    return count_[i] > 0 && alpha_enabled_ ? float(alpha_[i] / double(count_[i])) : 0.f;
+}
+
+std::vector<float> Film::resolve_alpha() const {
+    std::vector<float> a(size_t(width_) * size_t(height_));
+    for (int y = 0; y < height_; ++y)
+        for (int x = 0; x < width_; ++x) a[size_t(y) * size_t(width_) + size_t(x)] = alpha(x, y);
+    return a;
+}
+
+void Film::restore_alpha(std::vector<double> sums) {
+    alpha_enabled_ = true;
+    alpha_ = std::move(sums);
 }
 
 void Film::clear() { resize(width_, height_); }

@@ -33,6 +33,16 @@ public:
         sum_[i] += dvec3(L);
         count_[i] += 1;
     }
+    // Alpha (hdrfilm pixel_format rgba): per pixel, the fraction of its samples whose camera ray
+    // hit a surface, as Mitsuba. Off (and not allocated) until enable_alpha; kept over resize.
+    void enable_alpha();
+    bool has_alpha() const { return alpha_enabled_; }
+    void add_coverage(ivec2 px, bool hit) { alpha_[size_t(px.y) * size_t(width_) + size_t(px.x)] += hit ? 1.0 : 0.0; }
+    float alpha(int x, int y) const;
+    std::vector<float> resolve_alpha() const;  // row-major from the top-left, 1 float per pixel
+    const std::vector<double>& alpha_sums() const { return alpha_; }
+    void restore_alpha(std::vector<double> sums);
+
     // Splats are scaled by 1 / (passes) when resolved: splat_scale is set by the integrator.
     void add_splat(vec2 film_pos, vec3 L);
 
@@ -60,6 +70,8 @@ private:
     std::vector<dvec3> sum_;
     std::vector<uint32_t> count_;
     std::vector<dvec3> splat_;
+    bool alpha_enabled_ = false;
+    std::vector<double> alpha_;  // sums of coverage (0 or 1 per sample)
     double splat_scale_ = 1.0;
     std::atomic<uint64_t> nonfinite_{0};
 };

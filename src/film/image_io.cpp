@@ -33,6 +33,9 @@ void check_image(const std::string& path, const Image& img) {
     if (img.rgb.size() != size_t(img.width) * size_t(img.height) * 3)
         throw Error(path, 0, "image buffer holds " + std::to_string(img.rgb.size()) + " floats, expected " +
                                  std::to_string(size_t(img.width) * size_t(img.height) * 3));
+    if (!img.alpha.empty() && img.alpha.size() != size_t(img.width) * size_t(img.height))
+        throw Error(path, 0, "alpha buffer holds " + std::to_string(img.alpha.size()) + " floats, expected " +
+                                 std::to_string(size_t(img.width) * size_t(img.height)));
 }
 
 std::vector<unsigned char> read_whole_file(const std::string& path) {
@@ -74,19 +77,26 @@ struct ExrImageGuard {
 
 void write_exr(const std::string& path, const Image& img) {
     const size_t n = size_t(img.width) * size_t(img.height);
-    std::vector<float> r(n), g(n), b(n);
+    std::vector<float> r(n), g(n), b(n), a = img.alpha;
     for (size_t i = 0; i < n; ++i) {
         r[i] = img.rgb[3 * i + 0];
         g[i] = img.rgb[3 * i + 1];
         b[i] = img.rgb[3 * i + 2];
     }
-    // EXR readers expect the channel list sorted by name, so the planes go in as B, G, R.
-    float* planes[3] = {b.data(), g.data(), r.data()};
-    EXRChannelInfo channels[3];
+    // EXR readers expect the channel list sorted by name, so the planes go in as (A,) B, G, R.
+    const int nc = a.empty() ? 3 : 4;
+    float* planes[4] = {b.data(), g.data(), r.data(), nullptr};
+    const char* names[4] = {"B", "G", "R", nullptr};
+    if (nc == 4) {
+        float* p4[4] = {a.data(), b.data(), g.data(), r.data()};
+        const char* n4[4] = {"A", "B", "G", "R"};
+        std::copy(p4, p4 + 4, planes);
+        std::copy(n4, n4 + 4, names);
+    }
+    EXRChannelInfo channels[4];
     std::memset(channels, 0, sizeof(channels));
-    const char* names[3] = {"B", "G", "R"};
-    int pixel_types[3], requested[3];
-    for (int c = 0; c < 3; ++c) {
+    int pixel_types[4], requested[4];
+    for (int c = 0; c < nc; ++c) {
         std::strncpy(channels[c].name, names[c], sizeof(channels[c].name) - 1);
         channels[c].x_sampling = channels[c].y_sampling = 1;
         pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;  // type of the data we pass in
@@ -98,11 +108,11 @@ void write_exr(const std::string& path, const Image& img) {
     image.images = reinterpret_cast<unsigned char**>(planes);
     image.width = img.width;
     image.height = img.height;
-    image.num_channels = 3;
+    image.num_channels = nc;
 
     EXRHeader header;
     InitEXRHeader(&header);
-    header.num_channels = 3;
+    header.num_channels = nc;
     header.channels = channels;
     header.pixel_types = pixel_types;
     header.requested_pixel_types = requested;

@@ -8,9 +8,10 @@ namespace candela {
 struct Image {
     int width = 0, height = 0;
     std::vector<float> rgb;
+    std::vector<float> alpha;  // empty, or 1 float per pixel: written to EXR as channel A
 };
 
-// Writes .exr (tinyexr, 32-bit float RGB) or .pfm (little-endian, bottom-up as the format says)
+// Writes .exr (tinyexr, 32-bit float RGB, plus A when the image has alpha) or .pfm (little-endian, bottom-up as the format says)
 // by the file's extension. The file is written to a temporary name beside the target and renamed,
 // so a crash or kill never leaves a truncated image. Throws Error naming the file on failure.
 void write_linear_image(const std::string& path, const Image& img);

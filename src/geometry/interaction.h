@@ -27,11 +27,17 @@ struct SurfaceInteraction {
     vec3 p_error{0.f};
     vec3 ng{0.f, 0.f, 1.f};  // geometric normal, normalised, from the triangle's winding
     vec3 ns{0.f, 0.f, 1.f};  // shading normal (interpolated vertex normal, or ng)
+    // Texture coordinates and the world-space derivatives of the point with respect to them, as
+    // Mitsuba 3 defines them for meshes: with vertex uvs, uv is interpolated and dp/du, dp/dv solve
+    // p1-p0 = dpdu du1 + dpdv dv1, p2-p0 = dpdu du2 + dpdv dv2 (an orthonormal pair around ng when
+    // the uv triangle is degenerate); without, uv = (b1, b2), dpdu = p1-p0, dpdv = p2-p0.
+    // Analytic shapes set uv by their own Mitsuba parameterisation (geometry/analytic.cpp).
+    vec2 uv{0.f};
+    vec3 dpdu{1.f, 0.f, 0.f}, dpdv{0.f, 1.f, 0.f};
     uint32_t prim = ~0u;
     uint32_t shape = ~0u;
     PrimKind kind = PrimKind::Triangle;
-    vec2 uv{0.f};            // analytic shapes: Mitsuba's parameterisation (triangles: not yet)
-    uint32_t instance = ~0u; // as Hit::instance (p, normals and uv are in world space regardless)
+    uint32_t instance = ~0u;  // as Hit::instance (p, normals, dpdu/dpdv in world space regardless)
 };
 
 // Offsets p along the normal by the point's error bound, on the side of w, then rounds away from

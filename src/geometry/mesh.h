@@ -12,6 +12,12 @@ namespace candela {
 struct Mesh {
     std::vector<vec3> positions;
     std::vector<vec3> normals;       // per vertex; empty, or the same size as positions
+    // Per-vertex texture coordinates and colours of only the shapes that have them, each shape's
+    // as one run (Shape::uv_offset, Shape::color_offset): a scene or shape without them pays
+    // nothing. Colours are as the file gives them (Mitsuba 3.9 does not rescale integer PLY
+    // colours: a uchar 255 stays 255).
+    std::vector<vec2> uvs;
+    std::vector<vec3> colors;
     std::vector<uvec3> triangles;    // vertex indices
     std::vector<uint32_t> tri_shape; // shape index of each triangle
 
@@ -47,6 +53,12 @@ struct Shape {
     uint32_t material = 0;     // index into Scene::materials
     int32_t emitter = -1;      // index into Scene::emitters, or -1
     bool smooth = false;       // interpolate vertex normals (else the face normal shades)
+    static constexpr uint32_t kNone = ~0u;
+    uint32_t first_vertex = 0;        // the shape's vertices are a contiguous run of Mesh::positions
+    uint32_t uv_offset = kNone;       // vertex v's uv is Mesh::uvs[v - first_vertex + uv_offset]
+    uint32_t color_offset = kNone;    // likewise in Mesh::colors
+    bool has_uv() const { return uv_offset != kNone; }
+    bool has_color() const { return color_offset != kNone; }
     uint32_t first_triangle = 0;
     uint32_t triangle_count = 0;
     int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder (no triangles)

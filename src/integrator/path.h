@@ -6,6 +6,7 @@ namespace candela {
 
 struct PathStats {
     uint64_t rays = 0;  // closest-hit and shadow rays traced
+    uint64_t camera_hits = 0;  // camera rays that hit a surface (the film's alpha: hdrfilm rgba)
 };
 
 // Unidirectional path tracing with next-event estimation, combined with BSDF sampling by the

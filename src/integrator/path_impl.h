@@ -25,6 +25,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         Hit hit;
         ++stats.rays;
         if (!sc.accel->intersect(ray, hit)) break;  // no environment emitter (yet)
+        if (depth == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
         vec3 wo_world = -glm::normalize(ray.d);
 

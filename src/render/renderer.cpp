@@ -18,6 +18,7 @@ PassStats run_pass(const Scene& scene, Film& film, uint32_t first_sample, int sp
     // The scene's camera for this film: a preview renders the same view at a smaller size.
     Camera camera = scene.camera;
     camera.set_film_size(w, h);
+    const bool alpha = film.has_alpha();
     std::atomic<uint64_t> total_rays{0}, total_samples{0};
     std::atomic<bool> stopped{false};
 
@@ -36,11 +37,16 @@ PassStats run_pass(const Scene& scene, Film& film, uint32_t first_sample, int sp
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
                 for (int s = 0; s < spp; ++s) {
-                    sampler.start_pixel_sample(ivec2(x, y), first_sample + uint32_t(s));
+                    // Sampler dimensions of a camera sample: the pixel jitter (2), the lens (2, a
+                    // thin lens with an aperture only), then the path tracer's.
+                    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
                     vec2 jitter = sampler.next_2d();  // box filter: uniform over the pixel
-                    Ray ray = camera.generate_ray(vec2(float(x), float(y)) + jitter);
+                    vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                    Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                    const uint64_t hits = ps.camera_hits;
                     vec3 L = integrator.template Li<IndependentSampler, DiffuseOnly>(ray, sampler, ps);
                     film.add_sample(ivec2(x, y), L);
+                    if (alpha) film.add_coverage(ivec2(x, y), ps.camera_hits != hits);
                     ++samples;
                 }
             }

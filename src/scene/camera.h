@@ -1,5 +1,6 @@
 #pragma once
 #include "core/ray.h"
+#include "sampling/warp.h"
 
 namespace candela {
 
@@ -20,40 +21,122 @@ inline mat4 look_at(vec3 origin, vec3 target, vec3 up) {
 
 enum class FovAxis { X, Y, Diagonal, Smaller, Larger };
 
-// Mitsuba 3's `perspective` sensor. Camera space looks along +z with +y up and +x to the LEFT
-// of the image (Mitsuba's lookat builds the basis (left, up, forward)); to_world maps camera
-// space to world space. Film coordinates run from (0,0) at the top-left corner to (width, height).
+// The sensors of Mitsuba 3 that candela renders: a closed set chosen by a type field, so that ray
+// generation is one switch and no virtual call (src/sensors/perspective.cpp, thinlens.cpp and
+// orthographic.cpp in Mitsuba 3.9 define every convention below).
+enum class CameraType : uint8_t { Perspective, ThinLens, Orthographic };
+
+// Camera space looks along +z with +y up and +x to the LEFT of the image (Mitsuba's lookat builds
+// the basis (left, up, forward)); to_world maps camera space to world space (rigid for the
+// perspective and thin lens cameras; the orthographic camera's scale is its extent).
+//
+// Film coordinates are in pixels of the FULL film (Mitsuba's hdrfilm width x height): (0,0) is the
+// top-left corner, (W, H) the bottom-right. A crop window (crop_offset, crop_size) is the part of
+// the film that is rendered: the image's pixel (0,0) is film pixel crop_offset, and every ray is
+// the one the full film would have there. The field of view and the orthographic extent follow
+// the full film's aspect W / H, as in Mitsuba.
 struct Camera {
+    CameraType type = CameraType::Perspective;
     mat4 to_world{1.f};
+    // Perspective and thin lens: the field of view in degrees along fov_axis (a focal_length is
+    // converted to a diagonal fov by the loader, as Mitsuba's parse_fov).
     float fov_deg = 39.3077f;
     FovAxis fov_axis = FovAxis::X;
     float near_clip = 1e-2f;
     float far_clip = 1e4f;
+    // Perspective: the principal point's offset from the film's centre, in fractions of the full
+    // film's width and height (Mitsuba's principal_point_offset_x/y; +x moves the image content
+    // towards the left as in Mitsuba, whose sample space shifts by the offset).
+    vec2 principal_point_offset{0.f};
+    // Thin lens: the aperture's radius in camera space (0 renders exactly as the pinhole) and the
+    // distance along +z of the plane in focus.
+    float aperture_radius = 0.f;
+    float focus_distance = 1e4f;
+    // The full film and the crop window, in film pixels. film_size 0: the image is the whole film.
+    ivec2 film_size{0};
+    ivec2 crop_offset{0};
+    ivec2 crop_size{0};
 
-    // Prepares the per-ray constants for a film of the given size. Call before generate_ray.
+    // Prepares the per-ray constants for an image of the given size: the crop window (the whole
+    // film without one) rendered at width x height pixels. At the crop's own size an image pixel
+    // is exactly a film pixel; at another size (a preview, --width) the same window is scaled.
+    // Call before generate_ray.
     void set_film_size(int width, int height);
 
-    // The primary ray through film position `film` (in pixels, may be fractional). Unit direction;
-    // it starts at the near clip plane and ends at the far one, as in Mitsuba.
-    Ray generate_ray(vec2 film) const {
-        float sx = 1.f - 2.f * film.x * inv_width_;
-        float sy = 1.f - 2.f * film.y * inv_height_;
-        vec3 dc = glm::normalize(vec3(sx * tan_half_x_, sy * tan_half_y_, 1.f));
+    // True when a ray needs the 2D lens sample (a thin lens with an aperture). The renderer draws
+    // it from the sampler right after the pixel jitter, and only then, so that a pinhole camera's
+    // paths keep their dimensions.
+    bool needs_lens_sample() const { return type == CameraType::ThinLens && aperture_radius > 0.f; }
+
+    // The film pixel that image pixel `px` is: the sampler is seeded with it, so that a crop
+    // renders the same samples as the full film in that window.
+    ivec2 sampler_pixel(ivec2 px) const { return px + seed_offset_; }
+
+    // Film position (full-film pixels) of image pixel `px` at `jitter` in [0,1)^2 within it.
+    vec2 film_position(ivec2 px, vec2 jitter) const {
+        // Scale 1 and an integer offset at the crop's own size: float(px) + offset is exact, so a
+        // crop reproduces the full film's positions bit for bit.
+        return vec2(px) * pixel_scale_ + pixel_offset_ + jitter * pixel_scale_;
+    }
+
+    // The primary ray through film position `film` (full-film pixels); `lens` in [0,1)^2 is used by
+    // a thin lens with an aperture only (uniform over the aperture disk by the concentric map).
+    // The direction is unit length; the ray starts on the near clip plane and ends on the far one,
+    // as Mitsuba's sample_ray (for the orthographic camera: tmax = far - near, unscaled, as Mitsuba).
+    // The ray's importance weight is 1 for every type: nothing is divided by a pdf here.
+    Ray generate_ray(vec2 film, vec2 lens = vec2(0.5f)) const {
+        vec2 u = film * inv_film_;
         Ray r;
+        r.tmin = 0.f;
+        if (type == CameraType::Orthographic) {
+            vec3 p(1.f - 2.f * u.x, (1.f - 2.f * u.y) * inv_aspect_, near_clip);
+            r.o = vec3(to_world * glm::vec4(p, 1.f));
+            r.d = ortho_dir_;
+            r.tmax = far_clip - near_clip;
+            return r;
+        }
+        u += principal_point_offset;
+        // The point on the plane z = 1 in camera space.
+        vec3 p1((1.f - 2.f * u.x) * tan_half_x_, (1.f - 2.f * u.y) * tan_half_y_, 1.f);
+        vec3 dc, o = origin_;
+        if (needs_lens_sample()) {
+            // Thin lens: from a point on the aperture disk (z = 0) through the point of the focal
+            // plane that the pinhole ray would reach.
+            vec2 a = aperture_radius * square_to_uniform_disk_concentric(lens);
+            dc = glm::normalize(p1 * focus_distance - vec3(a, 0.f));
+            o = vec3(to_world * glm::vec4(a, 0.f, 1.f));
+        } else {
+            dc = glm::normalize(p1);
+        }
         r.d = glm::normalize(vec3(to_world * glm::vec4(dc, 0.f)));
         float inv_z = 1.f / dc.z;
-        r.o = origin_ + r.d * (near_clip * inv_z);
-        r.tmin = 0.f;
+        r.o = o + r.d * (near_clip * inv_z);
         r.tmax = (far_clip - near_clip) * inv_z;
         return r;
     }
+    Ray generate_ray(ivec2 px, vec2 jitter, vec2 lens) const { return generate_ray(film_position(px, jitter), lens); }
 
+    // The camera's position (the pinhole, the lens centre, or the orthographic camera's to_world
+    // origin).
     vec3 origin() const { return origin_; }
+    // The view direction in world space (unit).
+    vec3 forward() const { return glm::normalize(vec3(to_world[2])); }
 
 private:
     float tan_half_x_ = 0.35f, tan_half_y_ = 0.35f;
-    float inv_width_ = 1.f, inv_height_ = 1.f;
+    vec2 inv_film_{1.f};
+    float inv_aspect_ = 1.f;
+    vec2 pixel_scale_{1.f}, pixel_offset_{0.f};
+    ivec2 seed_offset_{0};
     vec3 origin_{0.f};
+    vec3 ortho_dir_{0.f, 0.f, 1.f};
 };
+
+// Mitsuba's parse_fov: the horizontal field of view (degrees) of `fov_deg` along `axis` on a
+// film of aspect width / height, computed in double as Mitsuba does.
+double horizontal_fov(double fov_deg, FovAxis axis, double aspect);
+
+// Mitsuba's focal_length: a 35 mm-equivalent focal length (mm) as a diagonal fov in degrees.
+double focal_length_to_fov(double focal_mm);
 
 }  // namespace candela

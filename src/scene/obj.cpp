@@ -207,6 +207,12 @@ bool ObjData::all_have_normals() const {
     return true;
 }
 
+bool ObjData::all_have_uvs() const {
+    for (unsigned char h : has_uv)
+        if (!h) return false;
+    return !has_uv.empty();
+}
+
 ObjData read_obj(const std::string& path, bool materials) {
     std::string text = read_text_file(path);
     validate_obj_text(path, text);
@@ -268,6 +274,14 @@ ObjData read_obj(const std::string& path, bool materials) {
         }
         out.normals.push_back(nrm);
         out.has_normal.push_back(has ? 1 : 0);
+        vec2 uv(0.f);
+        bool has_uv = ix.texcoord_index >= 0 && 2 * size_t(ix.texcoord_index) + 1 < attrib.texcoords.size();
+        if (has_uv) {
+            size_t q = 2 * size_t(ix.texcoord_index);
+            uv = vec2(float(attrib.texcoords[q]), float(attrib.texcoords[q + 1]));
+        }
+        out.uvs.push_back(uv);
+        out.has_uv.push_back(has_uv ? 1 : 0);
         vertex_of.emplace(key, id);
         return id;
     };

@@ -25,11 +25,14 @@ struct ObjData {
     std::vector<vec3> positions;
     std::vector<vec3> normals;           // unit, same size as positions; zero where the file gave none
     std::vector<unsigned char> has_normal;
+    std::vector<vec2> uvs;               // the file's vt (u, v as written), same size; zero where none
+    std::vector<unsigned char> has_uv;
     std::vector<ObjGroup> groups;        // in file order
     std::vector<ObjMaterial> materials;  // from the MTL files (empty unless requested)
     std::vector<std::string> warnings;   // non-fatal, "file: what"
 
     bool all_have_normals() const;
+    bool all_have_uvs() const;
 };
 
 // Reads and validates an OBJ file. Polygons are fan-triangulated ((0,1,2), (0,2,3), ...), as

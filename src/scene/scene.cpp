@@ -8,7 +8,8 @@ namespace candela {
 
 uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<vec3>& positions,
                                      const std::vector<vec3>& normals, const std::vector<uvec3>& triangles,
-                                     uint32_t material, int32_t emitter) {
+                                     uint32_t material, int32_t emitter, const std::vector<vec2>& uvs,
+                                     const std::vector<vec3>& colors) {
     Shape s;
     s.name = name;
     s.material = material;
@@ -23,6 +24,17 @@ uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<
     if (s.smooth && mesh.normals.size() < base) mesh.normals.resize(base, vec3(0.f));
     if (s.smooth) mesh.normals.insert(mesh.normals.end(), normals.begin(), normals.end());
     else if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
+    s.first_vertex = base;
+    if (!uvs.empty()) {
+        if (uvs.size() != positions.size()) throw Error(name, 0, "texture coordinates are not one per vertex");
+        s.uv_offset = uint32_t(mesh.uvs.size());
+        mesh.uvs.insert(mesh.uvs.end(), uvs.begin(), uvs.end());
+    }
+    if (!colors.empty()) {
+        if (colors.size() != positions.size()) throw Error(name, 0, "vertex colours are not one per vertex");
+        s.color_offset = uint32_t(mesh.colors.size());
+        mesh.colors.insert(mesh.colors.end(), colors.begin(), colors.end());
+    }
     uint32_t shape_index = uint32_t(shapes.size());
     for (const uvec3& t : triangles) {
         mesh.triangles.push_back(t + uvec3(base));
@@ -60,6 +72,22 @@ void check_params(const std::string& source, const std::vector<Shape>& shapes, c
         if (s.emitter >= 0 && size_t(s.emitter) >= p.emitters.size())
             throw Error(source, 0, "shape '" + s.name + "' names emitter " + std::to_string(s.emitter) + " of " +
                                        std::to_string(p.emitters.size()));
+    }
+}
+
+// A shape's uvs and colours are found from its vertex indices: they must stay in its run. Checks
+// the shapes of `mesh`: the scene's own (group -1) or those of one shapegroup.
+void check_vertex_runs(const std::string& source, const Mesh& mesh, const std::vector<Shape>& shapes, int32_t group) {
+    for (const Shape& s : shapes) {
+        if (s.group != group || (!s.has_uv() && !s.has_color())) continue;
+        for (uint32_t i = s.first_triangle; i < s.first_triangle + s.triangle_count && i < mesh.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                uint32_t v = mesh.triangles[i][k];
+                bool ok = v >= s.first_vertex &&
+                          (!s.has_uv() || uint64_t(v - s.first_vertex) + s.uv_offset < mesh.uvs.size()) &&
+                          (!s.has_color() || uint64_t(v - s.first_vertex) + s.color_offset < mesh.colors.size());
+                if (!ok) throw Error(source, 0, "shape '" + s.name + "' has a vertex without its uv or colour");
+            }
     }
 }
 
@@ -110,12 +138,25 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
             throw Error(desc.source, 0, "triangle index out of range");
     if (!mesh.normals.empty()) mesh.normals.resize(mesh.positions.size(), vec3(0.f));
+    for (size_t i = 0; i < mesh.uvs.size(); ++i)
+        if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y))
+            throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite texture coordinate");
+    for (size_t i = 0; i < mesh.colors.size(); ++i)
+        if (!all_finite(mesh.colors[i]))
+            throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite colour");
+    check_vertex_runs(desc.source, mesh, desc.shapes, -1);
     for (ShapeGroup& g : desc.groups) {
         for (const vec3& p : g.mesh.positions)
             if (!all_finite(p)) throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite vertex");
         for (const uvec3& t : g.mesh.triangles)
             if (t.x >= g.mesh.positions.size() || t.y >= g.mesh.positions.size() || t.z >= g.mesh.positions.size())
                 throw Error(desc.source, 0, "shapegroup '" + g.id + "': triangle index out of range");
+        for (const vec2& uv : g.mesh.uvs)
+            if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+                throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite texture coordinate");
+        for (const vec3& c : g.mesh.colors)
+            if (!all_finite(c)) throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite colour");
+        check_vertex_runs(desc.source, g.mesh, desc.shapes, int32_t(&g - desc.groups.data()));
         if (!g.mesh.normals.empty()) g.mesh.normals.resize(g.mesh.positions.size(), vec3(0.f));
     }
     for (Instance& in : desc.instances) {
@@ -183,6 +224,29 @@ SurfaceInteraction triangle_interaction(const Mesh& mesh, const std::vector<Shap
         float l2 = glm::dot(n, n);
         if (l2 > 0.f && std::isfinite(l2)) si.ns = n / std::sqrt(l2);
     }
+    // Mitsuba 3's mesh parameterisation (Mesh::compute_surface_interaction).
+    vec3 dp0 = p1 - p0, dp1 = p2 - p0;
+    const Shape& shape = shapes[si.shape];
+    if (shape.has_uv()) {
+        const vec2* uv = mesh.uvs.data() + shape.uv_offset - shape.first_vertex;
+        vec2 uv0 = uv[t.x], uv1 = uv[t.y], uv2 = uv[t.z];
+        si.uv = b0 * uv0 + hit.b1 * uv1 + hit.b2 * uv2;
+        vec2 duv0 = uv1 - uv0, duv1 = uv2 - uv0;
+        float det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if (det != 0.f && std::isfinite(1.f / det)) {
+            float inv = 1.f / det;
+            si.dpdu = (duv1.y * dp0 - duv0.y * dp1) * inv;
+            si.dpdv = (duv0.x * dp1 - duv1.x * dp0) * inv;
+        } else {
+            Frame f(si.ng);
+            si.dpdu = f.s;
+            si.dpdv = f.t;
+        }
+    } else {
+        si.uv = vec2(hit.b1, hit.b2);
+        si.dpdu = dp0;
+        si.dpdv = dp1;
+    }
     return si;
 }
 
@@ -206,22 +270,36 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
         glm::mat3 inv_t = glm::transpose(glm::mat3(in.to_object));
         si.ng = transform_normal(inv_t, si.ng);
         si.ns = transform_normal(inv_t, si.ns);
+        glm::mat3 lin(in.to_world);
+        si.dpdu = lin * si.dpdu;
+        si.dpdv = lin * si.dpdv;
         si.instance = hit.instance;
         return si;
     }
     return triangle_interaction(mesh, shapes, hit);
 }
 
+vec3 Scene::vertex_color(const Hit& hit) const {
+    const Mesh& m = hit.instance == ~0u ? mesh : groups[instances[hit.instance].group].mesh;
+    const Shape& shape = shapes[m.tri_shape[hit.prim]];
+    if (!shape.has_color()) return vec3(0.f);
+    const vec3* c = m.colors.data() + shape.color_offset - shape.first_vertex;
+    const uvec3& t = m.triangles[hit.prim];
+    return (1.f - hit.b1 - hit.b2) * c[t.x] + hit.b1 * c[t.y] + hit.b2 * c[t.z];
+}
+
 Scene::Memory Scene::memory() const {
     Memory m;
     m.triangles = mesh.triangles.size();
     m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
-             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t);
+             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t) +
+             mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
     m.instances = instances.size();
     for (const ShapeGroup& g : groups) {
         m.triangles += g.mesh.triangles.size();
         m.mesh += g.mesh.positions.capacity() * sizeof(vec3) + g.mesh.normals.capacity() * sizeof(vec3) +
                   g.mesh.triangles.capacity() * sizeof(uvec3) + g.mesh.tri_shape.capacity() * sizeof(uint32_t) +
+                  g.mesh.uvs.capacity() * sizeof(vec2) + g.mesh.colors.capacity() * sizeof(vec3) +
                   g.analytic.capacity() * sizeof(AnalyticShape);
     }
     m.mesh += instances.capacity() * sizeof(Instance);

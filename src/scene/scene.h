@@ -27,7 +27,8 @@ enum class SamplingMode { Light, Bsdf, Mis };
 
 // What the scene file says about rendering; the command line may override each field.
 struct RenderSettings {
-    int width = 512, height = 512;
+    int width = 512, height = 512;  // the rendered image: the film, or its crop window (Camera)
+    bool alpha = false;      // hdrfilm pixel_format rgba: the image gets an alpha channel
     int spp = 64;            // sampler sample_count: the default number of passes x spp per pass
     uint64_t seed = 0;
     int max_depth = -1;      // scattering events; -1 = unbounded (Russian roulette ends paths)
@@ -59,9 +60,11 @@ struct SceneDescription {
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
 
-    // Appends a shape made of the given triangles (world space). Returns its index.
+    // Appends a shape made of the given triangles (world space). Returns its index. `uvs` and
+    // `colors` are per vertex or empty (then the mesh stores none for this shape).
     uint32_t add_shape(const std::string& name, const std::vector<vec3>& positions, const std::vector<vec3>& normals,
-                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter);
+                       const std::vector<uvec3>& triangles, uint32_t material, int32_t emitter,
+                       const std::vector<vec2>& uvs = {}, const std::vector<vec3>& colors = {});
     // Appends an analytic shape (world space, see geometry/analytic.h). Returns its shape index.
     uint32_t add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material, int32_t emitter);
 };
@@ -116,6 +119,10 @@ public:
     // Point3fi), ng and ns by the inverse transpose and renormalised (as Mitsuba's Instance: a
     // mirroring to_world does not turn them around), uv unchanged.
     SurfaceInteraction interaction(const Hit& hit) const;
+    // The vertex colours interpolated at a hit (Mitsuba's mesh attribute "vertex_color", what a
+    // mesh_attribute texture reads); zero on a shape without colours. Apart from interaction() so
+    // that only shading that reads colours pays for them.
+    vec3 vertex_color(const Hit& hit) const;
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.

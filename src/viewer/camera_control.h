@@ -6,6 +6,8 @@
 // The state is (origin, target, up): `up` is the scene camera's up vector, kept fixed so that
 // orbiting never rolls the horizon. to_world is rebuilt with look_at (Mitsuba's convention: columns
 // left, up, forward, origin); a scene camera with a mirrored basis (det < 0) stays mirrored.
+// An orthographic camera keeps its to_world scale (its extent) through every move; its dolly zooms
+// (scales the extent), since moving it along the view changes nothing but the clipping.
 #include <algorithm>
 #include <cmath>
 #include "core/aabb.h"
@@ -25,6 +27,9 @@ public:
         initial_ = cam;
         to_world_ = cam.to_world;
         fov_deg_ = cam.fov_deg;
+        ortho_ = cam.type == CameraType::Orthographic;
+        extent_ = vec3(glm::length(vec3(cam.to_world[0])), glm::length(vec3(cam.to_world[1])),
+                       glm::length(vec3(cam.to_world[2])));
         origin_ = vec3(cam.to_world[3]);
         vec3 fwd = glm::normalize(vec3(cam.to_world[2]));
         up_ = glm::normalize(vec3(cam.to_world[1]));
@@ -64,8 +69,9 @@ public:
 
     // Moves camera and target together within the view plane, by (right, up) in units of the
     // visible height at the target's distance: pan(0, 1) shifts the view by one screen height.
+    // An orthographic camera's unit is its visible width (2 x its to_world x scale).
     void pan(float right, float up) {
-        float h = 2.f * distance() * std::tan(glm::radians(fov_deg_) * 0.5f);
+        float h = ortho_ ? 2.f * extent_.x : 2.f * distance() * std::tan(glm::radians(fov_deg_) * 0.5f);
         vec3 delta = h * (right * right_axis() + up * up_axis());
         origin_ += delta;
         target_ += delta;
@@ -73,7 +79,14 @@ public:
     }
 
     // Moves towards the target (steps > 0) by a factor 0.85 per step; never reaches it.
+    // An orthographic camera instead shrinks its extent by that factor (a zoom).
     void dolly(float steps) {
+        if (ortho_) {
+            extent_.x = std::max(extent_.x * std::pow(0.85f, steps), 1e-6f * scale_);
+            extent_.y = std::max(extent_.y * std::pow(0.85f, steps), 1e-6f * scale_);
+            rebuild();
+            return;
+        }
         vec3 offset = origin_ - target_;
         float d = glm::length(offset) * std::pow(0.85f, steps);
         d = std::max(d, 1e-4f * scale_);
@@ -114,6 +127,11 @@ private:
     void rebuild() {
         to_world_ = look_at(origin_, target_, up_);
         if (mirrored_) to_world_[0] = -to_world_[0];
+        if (ortho_) {
+            to_world_[0] *= extent_.x;
+            to_world_[1] *= extent_.y;
+            to_world_[2] *= extent_.z;
+        }
     }
 
     Camera initial_;
@@ -122,6 +140,8 @@ private:
     vec3 origin_{0.f}, target_{0.f, 0.f, 1.f}, up_{0.f, 1.f, 0.f};
     float scale_ = 1.f;
     bool mirrored_ = false;
+    bool ortho_ = false;
+    vec3 extent_{1.f};  // orthographic: the lengths of to_world's columns
 };
 
 }  // namespace candela

@@ -26,7 +26,9 @@ struct PickResult {
 inline PickResult pick(const Scene& scene, const Camera& camera, vec2 film_pos) {
     PickResult r;
     if (!scene.accel) return r;
-    Ray ray = camera.generate_ray(film_pos);
+    // film_pos is a position in the image: film_position maps it into the film (crop window).
+    Ray ray = camera.generate_ray(camera.film_position(ivec2(0), film_pos));
+    const vec3 from = camera.type == CameraType::Orthographic ? ray.o : camera.origin();
     Hit hit;
     if (!scene.accel->intersect(ray, hit)) return r;
     SurfaceInteraction si = scene.interaction(hit);
@@ -34,7 +36,7 @@ inline PickResult pick(const Scene& scene, const Camera& camera, vec2 film_pos) 
     r.hit = true;
     r.position = si.p;
     r.normal = si.ns;
-    r.distance = glm::length(si.p - camera.origin());
+    r.distance = glm::length(si.p - from);  // the orthographic camera: from its near plane
     r.shape = si.shape;
     r.material = shape.material;
     r.kind = hit.kind;

@@ -29,7 +29,8 @@ uint32_t group_of(XmlLoader& L, pugi::xml_node gn) {
         if (type == "shapegroup") throw L.error(c.node, "shapegroup '" + g.id + "': nested ShapeGroup is not permitted");
         if (type == "instance") throw L.error(c.node, "shapegroup '" + g.id + "': nested instancing is not permitted");
         const size_t pos0 = d.mesh.positions.size(), nrm0 = d.mesh.normals.size(), tri0 = d.mesh.triangles.size(),
-                     an0 = d.analytic.size(), shape0 = d.shapes.size();
+                     uv0 = d.mesh.uvs.size(), col0 = d.mesh.colors.size(), an0 = d.analytic.size(),
+                     shape0 = d.shapes.size();
         load_shape(L, sn);
         for (size_t s = shape0; s < d.shapes.size(); ++s)
             if (d.shapes[s].emitter >= 0)
@@ -37,7 +38,10 @@ uint32_t group_of(XmlLoader& L, pugi::xml_node gn) {
         // Move what the shape appended from the world description into the group.
         Mesh& w = d.mesh;
         const uint32_t gpos = uint32_t(g.mesh.positions.size()), gtri = uint32_t(g.mesh.triangles.size()),
-                       gan = uint32_t(g.analytic.size());
+                       gan = uint32_t(g.analytic.size()), guv = uint32_t(g.mesh.uvs.size()),
+                       gcol = uint32_t(g.mesh.colors.size());
+        g.mesh.uvs.insert(g.mesh.uvs.end(), w.uvs.begin() + long(uv0), w.uvs.end());
+        g.mesh.colors.insert(g.mesh.colors.end(), w.colors.begin() + long(col0), w.colors.end());
         g.mesh.positions.insert(g.mesh.positions.end(), w.positions.begin() + long(pos0), w.positions.end());
         if (w.normals.size() > pos0) {
             g.mesh.normals.resize(gpos, vec3(0.f));
@@ -53,12 +57,17 @@ uint32_t group_of(XmlLoader& L, pugi::xml_node gn) {
         w.normals.resize(std::min(nrm0, pos0));
         w.triangles.resize(tri0);
         w.tri_shape.resize(tri0);
+        w.uvs.resize(uv0);
+        w.colors.resize(col0);
         d.analytic.resize(an0);
         for (size_t s = shape0; s < d.shapes.size(); ++s) {
             Shape& sh = d.shapes[s];
             sh.group = int32_t(gi);
             sh.first_triangle = sh.first_triangle - uint32_t(tri0) + gtri;
             if (sh.analytic >= 0) sh.analytic = sh.analytic - int32_t(an0) + int32_t(gan);
+            sh.first_vertex = sh.first_vertex - uint32_t(pos0) + gpos;
+            if (sh.has_uv()) sh.uv_offset = sh.uv_offset - uint32_t(uv0) + guv;
+            if (sh.has_color()) sh.color_offset = sh.color_offset - uint32_t(col0) + gcol;
         }
     }
     L.finish(o);

@@ -780,8 +780,11 @@ uint32_t XmlLoader::material_for(Object& shape) {
         first = c.node;
     }
     if (found < 0) {
-        // Mitsuba gives such a shape a diffuse BSDF with reflectance 0.5.
-        scene_.materials.push_back({"default", DiffuseBsdf{vec3(0.5f)}, false});
+        // Mitsuba gives such a shape a diffuse BSDF with reflectance 0.5, or 0 when it emits
+        // (Shape::Shape in Mitsuba 3; checked against 3.9.1): a bare light does not scatter.
+        bool emits = false;
+        for (const Nested& c : shape.nested) emits = emits || c.tag == "emitter";
+        scene_.materials.push_back({"default", DiffuseBsdf{vec3(emits ? 0.f : 0.5f)}, false});
         found = int(scene_.materials.size() - 1);
     }
     return uint32_t(found);

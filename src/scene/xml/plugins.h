@@ -15,6 +15,8 @@ const PluginTable<BsdfFactory>& bsdf_plugins();
 struct ShapeGeometry {
     std::vector<vec3> positions, normals;  // object space; normals empty or per vertex
     std::vector<uvec3> triangles;
+    std::vector<vec2> uvs;     // per vertex or empty; unchanged by to_world
+    std::vector<vec3> colors;  // per vertex or empty
     // Mitsuba's rectangle and cube: under a mirroring to_world their geometric normal follows the
     // transformed winding but their shading normal is to_world^-T n_local, so the two disagree
     // (Mitsuba 3.9 checked). `normals` then become vertex normals, and are dropped otherwise.

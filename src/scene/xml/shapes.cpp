@@ -1,11 +1,12 @@
-// The shape family of the XML reader: triangle shapes (obj, rectangle, cube) and analytic shapes
-// placed in world space with their bsdf and area emitter; shapegroup and instance
-// (xml/instancing.cpp).
+// The shape family of the XML reader: triangle shapes (obj, rectangle, cube, and the mesh files
+// ply and serialized, read by src/shapes/) and analytic shapes placed in world space with their
+// bsdf and area emitter; shapegroup and instance (xml/instancing.cpp).
 #include <glm/glm.hpp>
 #include <fstream>
 #include "scene/obj.h"
 #include "scene/shapes_analytic.h"
 #include "scene/xml/plugins.h"
+#include "shapes/mesh_file.h"
 
 namespace candela {
 namespace xml {
@@ -16,7 +17,7 @@ ShapeGeometry make_obj(XmlLoader& L, Object& o) {
     if (!o.params.has("filename")) throw L.error(o.node, "shape 'obj' needs a 'filename' string");
     std::string file = o.params.get_string("filename", "");
     bool face_normals = o.params.get_bool("face_normals", false);
-    o.params.get_bool("flip_tex_coords", true);  // candela reads no texture coordinates
+    bool flip_tex = o.params.get_bool("flip_tex_coords", true);
     std::string full = L.resolve(o.node, file);
     if (!std::ifstream(full)) throw o.params.error("filename", "cannot open OBJ file '" + file + "' (" + full + ")");
     ObjData obj;
@@ -32,39 +33,98 @@ ShapeGeometry make_obj(XmlLoader& L, Object& o) {
         if (obj.all_have_normals()) g.normals = obj.normals;
         else g.recompute_normals = true;
     }
+    if (obj.all_have_uvs()) g.uvs = obj.uvs;
+    if (flip_tex)
+        for (vec2& uv : g.uvs) uv.y = 1.f - uv.y;
     return g;
 }
 
-ShapeGeometry make_rectangle(XmlLoader&, Object&) {
+// ply and serialized: the file's data, with Mitsuba's mesh flags.
+ShapeGeometry mesh_file_geometry(MeshFile f, bool face_normals, bool flip_tex) {
+    ShapeGeometry g;
+    g.positions = std::move(f.positions);
+    g.triangles = std::move(f.triangles);
+    g.uvs = std::move(f.uvs);
+    g.colors = std::move(f.colors);
+    if (!face_normals) {
+        if (!f.normals.empty()) g.normals = std::move(f.normals);
+        else g.recompute_normals = true;
+    }
+    if (flip_tex)
+        for (vec2& uv : g.uvs) uv.y = 1.f - uv.y;
+    return g;
+}
+
+std::string mesh_file_path(XmlLoader& L, Object& o, const char* what) {
+    if (!o.params.has("filename")) throw L.error(o.node, o.what() + " needs a 'filename' string");
+    std::string file = o.params.get_string("filename", "");
+    std::string full = L.resolve(o.node, file);
+    if (!std::ifstream(full)) throw o.params.error("filename", std::string("cannot open ") + what + " file '" + file + "' (" + full + ")");
+    return full;
+}
+
+ShapeGeometry make_ply(XmlLoader& L, Object& o) {
+    std::string full = mesh_file_path(L, o, "PLY");
+    bool face_normals = o.params.get_bool("face_normals", false);
+    bool flip_tex = o.params.get_bool("flip_tex_coords", false);  // Mitsuba's ply default, unlike obj
+    try {
+        return mesh_file_geometry(read_ply(full), face_normals, flip_tex);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
+    }
+}
+
+ShapeGeometry make_serialized(XmlLoader& L, Object& o) {
+    std::string full = mesh_file_path(L, o, "serialized");
+    bool face_normals = o.params.get_bool("face_normals", false);
+    int index = o.params.get_int("shape_index", 0);
+    if (index < 0) throw o.params.error("shape_index", "shape_index must be >= 0");
+    MeshFile f;
+    try {
+        f = read_serialized(full, index);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
+    }
+    // Mitsuba 3.9 reads past a serialized mesh's colours and ignores its face-normals flag
+    // (checked against 3.9.1): candela does the same, so both render the same image.
+    f.colors.clear();
+    return mesh_file_geometry(std::move(f), face_normals, false);
+}
+
+ShapeGeometry make_rectangle(XmlLoader&, Object& o) {
+    o.params.get_bool("face_normals", false);  // Mitsuba's rectangle is flat either way
     ShapeGeometry g;
     g.analytic = true;
     g.positions = {vec3(-1.f, -1.f, 0.f), vec3(1.f, -1.f, 0.f), vec3(1.f, 1.f, 0.f), vec3(-1.f, 1.f, 0.f)};
+    g.uvs = {vec2(0.f, 0.f), vec2(1.f, 0.f), vec2(1.f, 1.f), vec2(0.f, 1.f)};  // Mitsuba: uv = (p.xy + 1) / 2
     g.normals.assign(4, vec3(0.f, 0.f, 1.f));
     g.triangles = {uvec3(0, 1, 2), uvec3(0, 2, 3)};  // counter-clockwise seen from +z: normal +z
     return g;
 }
 
-ShapeGeometry make_cube(XmlLoader&, Object&) {
+ShapeGeometry make_cube(XmlLoader&, Object& o) {
+    bool face_normals = o.params.get_bool("face_normals", false);
     ShapeGeometry g;
-    g.analytic = true;
-    // Four corners per face (no shared vertices), wound so that every normal points outwards.
-    for (int axis = 0; axis < 3; ++axis)
-        for (int s = -1; s <= 1; s += 2) {
-            vec3 n(0.f);
-            n[axis] = float(s);
-            vec3 u(0.f), v(0.f);
-            u[(axis + 1) % 3] = 1.f;
-            v[(axis + 2) % 3] = 1.f;
-            if (s < 0) std::swap(u, v);  // keeps cross(u, v) == n
-            uint32_t b = uint32_t(g.positions.size());
-            g.positions.push_back(n - u - v);
-            g.positions.push_back(n + u - v);
-            g.positions.push_back(n + u + v);
-            g.positions.push_back(n - u + v);
-            g.normals.insert(g.normals.end(), 4, n);
-            g.triangles.push_back(uvec3(b, b + 1, b + 2));
-            g.triangles.push_back(uvec3(b, b + 2, b + 3));
+    g.analytic = !face_normals;  // Mitsuba's cube is a mesh: face_normals drops its vertex normals
+    // Mitsuba 3's cube (src/shapes/cube.cpp): four corners per face, in its order, with its uvs,
+    // wound so that every normal points outwards.
+    static const float kPos[24][3] = {
+        {1, -1, -1}, {1, -1, 1},  {-1, -1, 1}, {-1, -1, -1}, {1, 1, -1},  {-1, 1, -1}, {-1, 1, 1},  {1, 1, 1},
+        {1, -1, -1}, {1, 1, -1},  {1, 1, 1},   {1, -1, 1},   {1, -1, 1},  {1, 1, 1},   {-1, 1, 1},  {-1, -1, 1},
+        {-1, -1, 1}, {-1, 1, 1},  {-1, 1, -1}, {-1, -1, -1}, {1, 1, -1},  {1, -1, -1}, {-1, -1, -1}, {-1, 1, -1}};
+    static const float kUv[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    for (int f = 0; f < 6; ++f) {
+        uint32_t b = uint32_t(4 * f);
+        for (int k = 0; k < 4; ++k) {
+            const float* p = kPos[4 * f + k];
+            g.positions.push_back(vec3(p[0], p[1], p[2]));
+            g.uvs.push_back(vec2(kUv[k][0], kUv[k][1]));
         }
+        g.triangles.push_back(uvec3(b, b + 1, b + 2));
+        g.triangles.push_back(uvec3(b + 3, b, b + 2));
+        vec3 n = glm::normalize(glm::cross(g.positions[b + 1] - g.positions[b], g.positions[b + 2] - g.positions[b]));
+        if (!face_normals) g.normals.insert(g.normals.end(), 4, n);
+    }
     return g;
 }
 
@@ -75,6 +135,8 @@ const PluginTable<ShapeFactory>& shape_plugins() {
         {"obj", make_obj},
         {"rectangle", make_rectangle},
         {"cube", make_cube},
+        {"ply", make_ply},
+        {"serialized", make_serialized},
     };
     return table;
 }
@@ -127,9 +189,9 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
         for (vec3& nv : g.normals) nv = -nv;
     }
     std::string name = n.attribute("id") ? L.attr(n, "id")
-                       : o.type == "obj" ? o.params.get_string("filename", "obj")
+                       : o.params.has("filename") ? o.params.get_string("filename", o.type)
                                          : o.type + std::to_string(L.shape_counter);
-    L.scene().add_shape(name, g.positions, g.normals, g.triangles, material, emitter);
+    L.scene().add_shape(name, g.positions, g.normals, g.triangles, material, emitter, g.uvs, g.colors);
 }
 
 }  // namespace xml

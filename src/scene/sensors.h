@@ -1,0 +1,34 @@
+#pragma once
+// The sensor and film plugins of the Mitsuba XML reader, on an object's parameters alone (the XML
+// structure stays in the reader): `perspective`, `thinlens`, `orthographic` and `hdrfilm`, with
+// Mitsuba 3.9's parameter names, defaults and checks (src/render/sensor.cpp parse_fov and
+// ProjectiveCamera, src/sensors/*.cpp, src/render/film.cpp). Every value a factory reads is marked
+// used; errors name the parameter's line.
+#include <string>
+#include "scene/camera.h"
+#include "scene/params.h"
+
+namespace candela {
+
+// True for the sensor types make_sensor builds.
+bool is_supported_sensor(const std::string& type);
+// "perspective, thinlens, orthographic" for messages.
+const char* supported_sensors();
+
+// A camera of sensor type `type` (is_supported_sensor) from its parameters. The film geometry
+// (film_size, crop) is left for apply_film.
+Camera make_sensor(const std::string& type, const ParamSet& p);
+
+// What an hdrfilm says: its size, the crop window and whether the output has alpha.
+struct FilmDesc {
+    int width = 768, height = 576;
+    ivec2 crop_offset{0}, crop_size{768, 576};  // the whole film: nothing cropped
+    bool alpha = false;                  // pixel_format rgba
+};
+FilmDesc make_hdrfilm(const ParamSet& p);
+
+// Gives the camera the film's geometry (full size and crop window) and returns the rendered image
+// size: the crop window.
+ivec2 apply_film(const FilmDesc& f, Camera& cam);
+
+}  // namespace candela
