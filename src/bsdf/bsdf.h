@@ -10,6 +10,7 @@
 //           probability of that lobe and f carries the Dirac's weight, so only f / pdf matters.
 // TransportMode says which quantity flows along the path: Radiance (camera paths) or Importance
 // (light paths, for bidirectional methods), for the non-symmetric scaling of refraction.
+#include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -18,6 +19,7 @@
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
 #include "bsdf/plastic.h"
+#include "texture/texture.h"
 
 namespace candela {
 
@@ -110,13 +112,40 @@ inline void prepare(Bsdf& b) {
     }, b);
 }
 
+// A BSDF parameter driven by a texture. `apply` writes the texture's value at a surface point into
+// the parameter it drives; the loader, which knows the BSDF's type and parameter, chooses it.
+struct TextureSlot {
+    std::shared_ptr<const Texture> texture;
+    void (*apply)(Bsdf& bsdf, vec3 value) = nullptr;
+    const char* parameter = "";  // Mitsuba's name, for the viewer
+};
+
 // A material as scenes name it: a BSDF plus whether both sides of the surface scatter.
 // Mitsuba's BSDFs are one-sided (black from the back) unless wrapped in `twosided`; plain OBJ+MTL
-// scenes are two-sided, as users of those files expect.
+// scenes are two-sided, as users of those files expect. Textured parameters are in `textures`:
+// `bsdf` holds the rest (and, for those, values that bsdf_at overwrites at each point).
 struct Material {
     std::string name;
     Bsdf bsdf;
     bool two_sided = false;
+    std::vector<TextureSlot> textures;
+
+    bool textured() const { return !textures.empty(); }
+    bool uses_vertex_colors() const {
+        for (const TextureSlot& t : textures)
+            if (t.texture->uses_vertex_colors()) return true;
+        return false;
+    }
 };
+
+// The material's BSDF at a surface point: the material's own when nothing is textured (no copy, the
+// case of every untextured scene), else a copy in `scratch` with its textured parameters evaluated
+// at `q`.
+inline const Bsdf& bsdf_at(const Material& m, const TextureQuery& q, Bsdf& scratch) {
+    if (!m.textured()) return m.bsdf;
+    scratch = m.bsdf;
+    for (const TextureSlot& t : m.textures) t.apply(scratch, t.texture->eval(q));
+    return scratch;
+}
 
 }  // namespace candela

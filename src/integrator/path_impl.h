@@ -45,6 +45,8 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
 
         const Shape& shape = sc.shapes[si.shape];
         const Material& mat = sc.materials[shape.material];
+        Bsdf textured;
+        const Bsdf& bsdf = mat.textured() ? bsdf_at(mat, sc.texture_query(si, hit), textured) : mat.bsdf;
         // Shading frame; a two-sided material is seen from whichever side the ray arrives.
         vec3 n = si.ns;
         if (mat.two_sided && glm::dot(wo_world, n) < 0.f) {
@@ -55,18 +57,18 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         vec3 wo = frame.to_local(wo_world);
 
         // Next-event estimation.
-        if (mode != SamplingMode::Bsdf && have_lights && has_smooth_component_in<DiffuseOnly>(mat.bsdf)) {
+        if (mode != SamplingMode::Bsdf && have_lights && has_smooth_component_in<DiffuseOnly>(bsdf)) {
             float ul = sampler.next_1d();
             vec2 up = sampler.next_2d();
             LightSample ls;
             if (sc.lights.sample_li(si.p, ul, up, ls)) {
                 vec3 wi = frame.to_local(ls.wi);
-                vec3 f = eval_in<DiffuseOnly>(mat.bsdf, wo, wi);
+                vec3 f = eval_in<DiffuseOnly>(bsdf, wo, wi);
                 if (!is_black(f)) {
                     Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
                     ++stats.rays;
                     if (!sc.accel->occluded(shadow)) {
-                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, pdf_in<DiffuseOnly>(mat.bsdf, wo, wi)) : 1.f;
+                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, pdf_in<DiffuseOnly>(bsdf, wo, wi)) : 1.f;
                         L += beta * f * ls.Le * (w / ls.pdf);
                     }
                 }
@@ -80,7 +82,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         // Continue the path by sampling the BSDF.
         float u1 = sampler.next_1d();
         vec2 u2 = sampler.next_2d();
-        std::optional<BsdfSample> bs = sample_in<DiffuseOnly>(mat.bsdf, wo, u1, u2);
+        std::optional<BsdfSample> bs = sample_in<DiffuseOnly>(bsdf, wo, u1, u2);
         if (!bs || !(bs->pdf > 0.f)) break;
         beta *= bs->weight();
         if (is_black(beta)) break;

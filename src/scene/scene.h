@@ -123,6 +123,13 @@ public:
     // mesh_attribute texture reads); zero on a shape without colours. Apart from interaction() so
     // that only shading that reads colours pays for them.
     vec3 vertex_color(const Hit& hit) const;
+    // What a texture reads at a hit: the uv, and the vertex colour where the shape has colours.
+    TextureQuery texture_query(const SurfaceInteraction& si, const Hit& hit) const {
+        TextureQuery q;
+        q.uv = si.uv;
+        if (hit.kind == PrimKind::Triangle && shapes[si.shape].has_color()) q.vertex_color = vertex_color(hit);
+        return q;
+    }
 
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.

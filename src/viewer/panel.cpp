@@ -89,6 +89,8 @@ const char* bsdf_type_name(const Bsdf& b) {
 
 bool edit_material(Material& m) {
     bool changed = std::visit([](auto& b) { return edit_bsdf(b); }, m.bsdf);
+    // A textured parameter takes its value from the texture at each point: its slider has no effect.
+    for (const TextureSlot& t : m.textures) ImGui::TextDisabled("%s: a texture (the slider above has no effect)", t.parameter);
     changed |= ImGui::Checkbox("two-sided", &m.two_sided);
     return changed;
 }

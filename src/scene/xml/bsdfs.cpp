@@ -9,10 +9,34 @@ namespace xml {
 
 namespace {
 
-Material make_diffuse(XmlLoader&, Object& o) {
+// Colour parameters that a texture may drive, per BSDF: Mitsuba's name and where the value goes.
+template <class B, vec3 B::*Field>
+void set_field(Bsdf& b, vec3 v) { std::get<B>(b).*Field = v; }
+
+struct TexturableParam {
+    const char* name;
+    void (*apply)(Bsdf&, vec3);
+};
+
+// The textures nested in a BSDF, each bound to the parameter it names; a texture for a parameter
+// that candela does not texture (e.g. a roughness) is an error, not a silent constant.
+Material with_textures(XmlLoader& L, Object& o, Material m, std::initializer_list<TexturableParam> params) {
+    for (const TexturableParam& p : params)
+        if (auto t = nested_texture(L, o, p.name)) {
+            if (o.params.has(p.name)) throw o.params.error(p.name, std::string("'") + p.name + "' is given both as a value and as a texture");
+            m.textures.push_back(TextureSlot{t, p.apply, p.name});
+        }
+    for (const Nested& c : o.nested)
+        if (!c.used && c.tag == "texture")
+            throw L.error(c.node, "a texture for '" + L.attr(c.node, "name") + "' is not supported in " + o.what());
+    return m;
+}
+
+Material make_diffuse(XmlLoader& L, Object& o) {
     vec3 r = o.params.get_rgb("reflectance", vec3(0.5f));
     if (!(min_component(r) >= 0.f)) throw o.params.error("reflectance", "reflectance must not be negative");
-    return Material{"", DiffuseBsdf{r}, false};  // Mitsuba's BSDFs are one-sided
+    return with_textures(L, o, Material{"", DiffuseBsdf{r}, false},  // Mitsuba's BSDFs are one-sided
+                         {{"reflectance", set_field<DiffuseBsdf, &DiffuseBsdf::albedo>}});
 }
 
 // ---- BSDFs of issue 5 (conductor, plastic, dielectric, twosided) -------------------------------
@@ -67,14 +91,17 @@ ConductorBsdf conductor_params(Object& o) {
     return c;
 }
 
-Material make_conductor(XmlLoader&, Object& o) {
-    return Material{"", conductor_params(o), false};
+constexpr TexturableParam kConductorTextures[] = {
+    {"specular_reflectance", set_field<ConductorBsdf, &ConductorBsdf::specular_reflectance>}};
+
+Material make_conductor(XmlLoader& L, Object& o) {
+    return with_textures(L, o, Material{"", conductor_params(o), false}, {kConductorTextures[0]});
 }
 
-Material make_roughconductor(XmlLoader&, Object& o) {
+Material make_roughconductor(XmlLoader& L, Object& o) {
     ConductorBsdf c = conductor_params(o);
     c.alpha = microfacet_alpha(o, 0.1f);
-    return Material{"", c, false};
+    return with_textures(L, o, Material{"", c, false}, {kConductorTextures[0]});
 }
 
 PlasticBsdf plastic_params(Object& o) {
@@ -87,18 +114,22 @@ PlasticBsdf plastic_params(Object& o) {
     return p;
 }
 
-Material make_plastic(XmlLoader&, Object& o) {
+constexpr TexturableParam kPlasticTextures[] = {
+    {"diffuse_reflectance", set_field<PlasticBsdf, &PlasticBsdf::diffuse_reflectance>},
+    {"specular_reflectance", set_field<PlasticBsdf, &PlasticBsdf::specular_reflectance>}};
+
+Material make_plastic(XmlLoader& L, Object& o) {
     PlasticBsdf p = plastic_params(o);
     p.prepare();
-    return Material{"", p, false};
+    return with_textures(L, o, Material{"", p, false}, {kPlasticTextures[0], kPlasticTextures[1]});
 }
 
-Material make_roughplastic(XmlLoader&, Object& o) {
+Material make_roughplastic(XmlLoader& L, Object& o) {
     PlasticBsdf p = plastic_params(o);
     p.alpha = microfacet_alpha(o, 0.1f);
     if (p.int_ior == p.ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
     p.prepare();
-    return Material{"", p, false};
+    return with_textures(L, o, Material{"", p, false}, {kPlasticTextures[0], kPlasticTextures[1]});
 }
 
 DielectricBsdf dielectric_params(Object& o) {
@@ -111,14 +142,18 @@ DielectricBsdf dielectric_params(Object& o) {
     return d;
 }
 
-Material make_dielectric(XmlLoader&, Object& o) {
-    return Material{"", dielectric_params(o), false};
+constexpr TexturableParam kDielectricTextures[] = {
+    {"specular_reflectance", set_field<DielectricBsdf, &DielectricBsdf::specular_reflectance>},
+    {"specular_transmittance", set_field<DielectricBsdf, &DielectricBsdf::specular_transmittance>}};
+
+Material make_dielectric(XmlLoader& L, Object& o) {
+    return with_textures(L, o, Material{"", dielectric_params(o), false}, {kDielectricTextures[0], kDielectricTextures[1]});
 }
 
-Material make_roughdielectric(XmlLoader&, Object& o) {
+Material make_roughdielectric(XmlLoader& L, Object& o) {
     DielectricBsdf d = dielectric_params(o);
     d.alpha = microfacet_alpha(o, 0.1f);
-    return Material{"", d, false};
+    return with_textures(L, o, Material{"", d, false}, {kDielectricTextures[0], kDielectricTextures[1]});
 }
 
 Material make_twosided(XmlLoader& L, Object& o) {

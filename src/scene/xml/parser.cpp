@@ -838,6 +838,8 @@ SceneDescription XmlLoader::load() {
                 load_shape(*this, c);
             } else if (tag == "emitter") {
                 load_emitter(*this, c);
+            } else if (tag == "texture") {
+                load_texture(*this, c);  // checked now; used where a <ref> names it
             } else if (is_property_tag(tag) || tag == "ref") {
                 throw error(c, "unexpected <" + tag + "> directly inside <scene>");
             } else if (is_object_tag(tag)) {

@@ -113,6 +113,8 @@ public:
     // to be a <tag>).
     pugi::xml_node definition(const Nested& c, const std::string& tag);
     int shape_counter = 0;  // shapes read so far (for default names)
+    // Textures built so far, by element: one referenced several times is built once.
+    std::map<const void*, std::shared_ptr<const Texture>> textures;
 
     // ---- bsdfs, shared by the shape and bsdf families ----
     // The material index of a bsdf element (built once even when referenced several times).

@@ -50,6 +50,16 @@ void load_sensor(XmlLoader& L, pugi::xml_node n);
 // A film's nested <rfilter> elements (at most one), for film factories.
 void load_rfilters(XmlLoader& L, Object& film, RenderSettings& s);
 
+// ---- textures.cpp: <texture> -> Texture, and texture-valued parameters of other plugins ----
+using TextureFactory = Texture (*)(XmlLoader&, Object&);
+const PluginTable<TextureFactory>& texture_plugins();
+// The texture a <texture> element (or a <ref> to one) stands for, built once.
+std::shared_ptr<const Texture> load_texture(XmlLoader& L, pugi::xml_node n);
+// The nested <texture> or <ref> to one with name="name" in `o`, marked used; null when none.
+std::shared_ptr<const Texture> nested_texture(XmlLoader& L, Object& o, const std::string& name);
+// A colour parameter given as a value or as a texture: the texture (a constant one for a value).
+std::shared_ptr<const Texture> rgb_or_texture(XmlLoader& L, Object& o, const std::string& name, vec3 def);
+
 // ---- integrators.cpp: <integrator> -> RenderSettings ----
 using IntegratorFactory = void (*)(XmlLoader&, Object&, RenderSettings&);
 const PluginTable<IntegratorFactory>& integrator_plugins();
