@@ -373,7 +373,7 @@ TEST(SceneXml, NoSensorGivesFramingCamera) {
 TEST(SceneXml, Errors) {
     expect_error("<shape type=\"rectangle\">\n<foo/></shape>\n", 3, "unknown tag <foo>");
     expect_error("\n<bar/>\n", 3, "unknown tag <bar>");
-    expect_error("<shape type=\"shapegroup\"/>\n", 2, "unsupported shape type 'shapegroup'");
+    expect_error("<shape type=\"bsplinecurve\"/>\n", 2, "unsupported shape type 'bsplinecurve'");
     expect_error("\n<bsdf type=\"blendbsdf\" id=\"c\"/>\n", 3, "unsupported bsdf type 'blendbsdf'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"measured\"/></shape>\n", 3, "unsupported bsdf type 'measured'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "needs a nested <bsdf>");

@@ -246,6 +246,41 @@ uint64_t scene_fingerprint(const Scene& scene) {
         }
         for (const Shape& s : scene.shapes) h.i64(s.analytic);
     }
+    // Shapegroups and instances (only when there are some, as above).
+    if (!scene.instances.empty() || !scene.groups.empty()) {
+        h.str("instances");
+        h.u64(scene.groups.size());
+        for (const ShapeGroup& g : scene.groups) {
+            const Mesh& gm = g.mesh;
+            h.u64(gm.positions.size());
+            h.bytes(gm.positions.data(), gm.positions.size() * sizeof(vec3));
+            h.u64(gm.normals.size());
+            h.bytes(gm.normals.data(), gm.normals.size() * sizeof(vec3));
+            h.u64(gm.triangles.size());
+            h.bytes(gm.triangles.data(), gm.triangles.size() * sizeof(uvec3));
+            h.bytes(gm.tri_shape.data(), gm.tri_shape.size() * sizeof(uint32_t));
+            h.u64(gm.uvs.size());
+            h.bytes(gm.uvs.data(), gm.uvs.size() * sizeof(vec2));
+            h.u64(gm.colors.size());
+            h.bytes(gm.colors.data(), gm.colors.size() * sizeof(vec3));
+            h.u64(g.analytic.size());
+            for (const AnalyticShape& a : g.analytic) {
+                h.u64(uint64_t(a.kind));
+                h.u64(a.shape);
+                h.u64(a.flip);
+                h.v3(a.center);
+                h.f32(a.radius);
+                h.f32(a.length);
+                h.bytes(&a.to_world, sizeof(a.to_world));
+            }
+        }
+        h.u64(scene.instances.size());
+        for (const Instance& in : scene.instances) {
+            h.u64(in.group);
+            h.bytes(&in.to_world, sizeof(in.to_world));
+        }
+        for (const Shape& s : scene.shapes) h.i64(s.group);
+    }
     h.u64(scene.emitters.size());
     for (const AreaEmitter& e : scene.emitters) h.v3(e.radiance);
 

@@ -16,6 +16,9 @@ struct Hit {
     uint32_t prim = ~0u;                // triangle index, or index into Geometry::analytic
     PrimKind kind = PrimKind::Triangle;
     vec3 local{0.f};                    // analytic shapes only (see intersect_analytic)
+    // Index into Geometry::instances when the primitive belongs to an instanced shapegroup: prim,
+    // kind and local are then in the group's own space. ~0u for the scene's own primitives.
+    uint32_t instance = ~0u;
 };
 
 // A point on a surface with what shading needs. p_error bounds |p - exact point| per axis.
@@ -34,6 +37,7 @@ struct SurfaceInteraction {
     uint32_t prim = ~0u;
     uint32_t shape = ~0u;
     PrimKind kind = PrimKind::Triangle;
+    uint32_t instance = ~0u;  // as Hit::instance (p, normals, dpdu/dpdv in world space regardless)
 };
 
 // Offsets p along the normal by the point's error bound, on the side of w, then rounds away from

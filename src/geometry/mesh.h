@@ -62,6 +62,9 @@ struct Shape {
     uint32_t first_triangle = 0;
     uint32_t triangle_count = 0;
     int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder (no triangles)
+    // Index into Geometry::groups for a shape of a shapegroup: first_triangle and analytic then
+    // index the group's mesh and shapes, and the shape is only seen through instances.
+    int32_t group = -1;
 };
 
 }  // namespace candela

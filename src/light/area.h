@@ -50,7 +50,10 @@ public:
     int32_t emitter_of(uint32_t prim) const { return prim_light_.empty() ? -1 : tri_emitter_[prim]; }
     // The emitter of the primitive a ray hit (a triangle or an analytic shape), or -1.
     int32_t emitter_of(const Hit& hit) const {
-        if (hit.kind != PrimKind::Triangle) return analytic_emitter_.empty() ? -1 : analytic_emitter_[hit.prim];
+        // Instanced shapes never emit (Mitsuba refuses emitters in a shapegroup); one test for both
+        // rare cases, as in Scene::interaction.
+        if (__builtin_expect((uint32_t(hit.kind) | (hit.instance + 1u)) != 0u, 0))
+            return hit.instance != ~0u || analytic_emitter_.empty() ? -1 : analytic_emitter_[hit.prim];
         return emitter_of(hit.prim);
     }
 

@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 #include "core/error.h"
+#include "accel/instances.h"
 #include "accel/with_analytic.h"
 #include "film/film.h"
 
@@ -74,6 +75,22 @@ void check_params(const std::string& source, const std::vector<Shape>& shapes, c
     }
 }
 
+// A shape's uvs and colours are found from its vertex indices: they must stay in its run. Checks
+// the shapes of `mesh`: the scene's own (group -1) or those of one shapegroup.
+void check_vertex_runs(const std::string& source, const Mesh& mesh, const std::vector<Shape>& shapes, int32_t group) {
+    for (const Shape& s : shapes) {
+        if (s.group != group || (!s.has_uv() && !s.has_color())) continue;
+        for (uint32_t i = s.first_triangle; i < s.first_triangle + s.triangle_count && i < mesh.triangles.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                uint32_t v = mesh.triangles[i][k];
+                bool ok = v >= s.first_vertex &&
+                          (!s.has_uv() || uint64_t(v - s.first_vertex) + s.uv_offset < mesh.uvs.size()) &&
+                          (!s.has_color() || uint64_t(v - s.first_vertex) + s.color_offset < mesh.colors.size());
+                if (!ok) throw Error(source, 0, "shape '" + s.name + "' has a vertex without its uv or colour");
+            }
+    }
+}
+
 std::vector<Material> prepared(std::vector<Material> materials) {
     for (Material& m : materials) prepare(m.bsdf);
     return materials;
@@ -101,6 +118,8 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       mesh(geometry->mesh),
       shapes(geometry->shapes),
       analytic(geometry->analytic),
+      groups(geometry->groups),
+      instances(geometry->instances),
       accel(std::move(accel_)),
       light_set(std::move(lights_)),
       lights(*light_set),
@@ -125,17 +144,24 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     for (size_t i = 0; i < mesh.colors.size(); ++i)
         if (!all_finite(mesh.colors[i]))
             throw Error(desc.source, 0, "vertex " + std::to_string(i) + " has a NaN or infinite colour");
-    // A shape's uvs and colours are found from its vertex indices: they must stay in its run.
-    for (const Shape& s : desc.shapes) {
-        if (!s.has_uv() && !s.has_color()) continue;
-        for (uint32_t i = s.first_triangle; i < s.first_triangle + s.triangle_count && i < mesh.triangles.size(); ++i)
-            for (int k = 0; k < 3; ++k) {
-                uint32_t v = mesh.triangles[i][k];
-                bool ok = v >= s.first_vertex &&
-                          (!s.has_uv() || uint64_t(v - s.first_vertex) + s.uv_offset < mesh.uvs.size()) &&
-                          (!s.has_color() || uint64_t(v - s.first_vertex) + s.color_offset < mesh.colors.size());
-                if (!ok) throw Error(desc.source, 0, "shape '" + s.name + "' has a vertex without its uv or colour");
-            }
+    check_vertex_runs(desc.source, mesh, desc.shapes, -1);
+    for (ShapeGroup& g : desc.groups) {
+        for (const vec3& p : g.mesh.positions)
+            if (!all_finite(p)) throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite vertex");
+        for (const uvec3& t : g.mesh.triangles)
+            if (t.x >= g.mesh.positions.size() || t.y >= g.mesh.positions.size() || t.z >= g.mesh.positions.size())
+                throw Error(desc.source, 0, "shapegroup '" + g.id + "': triangle index out of range");
+        for (const vec2& uv : g.mesh.uvs)
+            if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+                throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite texture coordinate");
+        for (const vec3& c : g.mesh.colors)
+            if (!all_finite(c)) throw Error(desc.source, 0, "shapegroup '" + g.id + "' has a NaN or infinite colour");
+        check_vertex_runs(desc.source, g.mesh, desc.shapes, int32_t(&g - desc.groups.data()));
+        if (!g.mesh.normals.empty()) g.mesh.normals.resize(g.mesh.positions.size(), vec3(0.f));
+    }
+    for (Instance& in : desc.instances) {
+        if (in.group >= desc.groups.size()) throw Error(desc.source, 0, "instance of an unknown shapegroup");
+        in.bounds = transform_box(in.to_world, desc.groups[in.group].bounds());
     }
     SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters)};
     check_params(desc.source, desc.shapes, params);
@@ -144,13 +170,22 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     geometry->mesh = std::move(desc.mesh);
     geometry->shapes = std::move(desc.shapes);
     geometry->analytic = std::move(desc.analytic);
+    geometry->groups = std::move(desc.groups);
+    geometry->instances = std::move(desc.instances);
     geometry->bounds = geometry->mesh.bounds();
     for (const AnalyticShape& a : geometry->analytic) geometry->bounds.expand(a.bounds());
+    for (const Instance& in : geometry->instances) geometry->bounds.expand(in.bounds);
     std::unique_ptr<Accel> tri_accel = make_accel(accel_name, geometry->mesh);
-    // Only a scene with analytic shapes pays for querying them.
-    std::shared_ptr<const Accel> accel =
-        geometry->analytic.empty() ? std::shared_ptr<const Accel>(std::move(tri_accel))
-                                   : std::make_shared<WithAnalyticAccel>(std::move(tri_accel), geometry->analytic);
+    // Only a scene with analytic shapes pays for querying them, and only one with instances for
+    // the instance level.
+    if (!geometry->analytic.empty())
+        tri_accel = std::make_unique<WithAnalyticAccel>(std::move(tri_accel), geometry->analytic);
+    if (!geometry->instances.empty()) {
+        bool own = !geometry->mesh.triangles.empty() || !geometry->analytic.empty();
+        tri_accel = std::make_unique<InstanceAccel>(own ? std::move(tri_accel) : nullptr, geometry->groups,
+                                                    geometry->instances, accel_name);
+    }
+    std::shared_ptr<const Accel> accel(std::move(tri_accel));
     auto lights = std::make_shared<LightSet>();
     lights->build(geometry->mesh, geometry->shapes, params.emitters, &geometry->analytic);
     return std::shared_ptr<const Scene>(
@@ -169,8 +204,9 @@ std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     return std::shared_ptr<const Scene>(new Scene(source, geometry, accel, std::move(lights_for), p, warnings));
 }
 
-SurfaceInteraction Scene::interaction(const Hit& hit) const {
-    if (__builtin_expect(hit.kind != PrimKind::Triangle, 0)) return analytic_interaction(analytic[hit.prim], hit);
+namespace {
+
+SurfaceInteraction triangle_interaction(const Mesh& mesh, const std::vector<Shape>& shapes, const Hit& hit) {
     SurfaceInteraction si;
     si.prim = hit.prim;
     si.shape = mesh.tri_shape[hit.prim];
@@ -214,11 +250,41 @@ SurfaceInteraction Scene::interaction(const Hit& hit) const {
     return si;
 }
 
+vec3 transform_normal(const glm::mat3& inv_t, vec3 n) {
+    vec3 w = inv_t * n;
+    float l2 = glm::dot(w, w);
+    return l2 > 0.f && std::isfinite(l2) ? w / std::sqrt(l2) : n;
+}
+
+}  // namespace
+
+SurfaceInteraction Scene::interaction(const Hit& hit) const {
+    // One test for both rare cases: an analytic shape (kind != 0) or an instance (instance != ~0u).
+    if (__builtin_expect((uint32_t(hit.kind) | (hit.instance + 1u)) != 0u, 0)) {
+        if (hit.instance == ~0u) return analytic_interaction(analytic[hit.prim], hit);
+        const Instance& in = instances[hit.instance];
+        const ShapeGroup& g = groups[in.group];
+        SurfaceInteraction si = hit.kind == PrimKind::Triangle ? triangle_interaction(g.mesh, shapes, hit)
+                                                               : analytic_interaction(g.analytic[hit.prim], hit);
+        si.p = transform_point_error(in.to_world, si.p, si.p_error, &si.p_error);
+        glm::mat3 inv_t = glm::transpose(glm::mat3(in.to_object));
+        si.ng = transform_normal(inv_t, si.ng);
+        si.ns = transform_normal(inv_t, si.ns);
+        glm::mat3 lin(in.to_world);
+        si.dpdu = lin * si.dpdu;
+        si.dpdv = lin * si.dpdv;
+        si.instance = hit.instance;
+        return si;
+    }
+    return triangle_interaction(mesh, shapes, hit);
+}
+
 vec3 Scene::vertex_color(const Hit& hit) const {
-    const Shape& shape = shapes[mesh.tri_shape[hit.prim]];
+    const Mesh& m = hit.instance == ~0u ? mesh : groups[instances[hit.instance].group].mesh;
+    const Shape& shape = shapes[m.tri_shape[hit.prim]];
     if (!shape.has_color()) return vec3(0.f);
-    const vec3* c = mesh.colors.data() + shape.color_offset - shape.first_vertex;
-    const uvec3& t = mesh.triangles[hit.prim];
+    const vec3* c = m.colors.data() + shape.color_offset - shape.first_vertex;
+    const uvec3& t = m.triangles[hit.prim];
     return (1.f - hit.b1 - hit.b2) * c[t.x] + hit.b1 * c[t.y] + hit.b2 * c[t.z];
 }
 
@@ -228,6 +294,15 @@ Scene::Memory Scene::memory() const {
     m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
              mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t) +
              mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
+    m.instances = instances.size();
+    for (const ShapeGroup& g : groups) {
+        m.triangles += g.mesh.triangles.size();
+        m.mesh += g.mesh.positions.capacity() * sizeof(vec3) + g.mesh.normals.capacity() * sizeof(vec3) +
+                  g.mesh.triangles.capacity() * sizeof(uvec3) + g.mesh.tri_shape.capacity() * sizeof(uint32_t) +
+                  g.mesh.uvs.capacity() * sizeof(vec2) + g.mesh.colors.capacity() * sizeof(vec3) +
+                  g.analytic.capacity() * sizeof(AnalyticShape);
+    }
+    m.mesh += instances.capacity() * sizeof(Instance);
     m.accel = accel ? accel->memory_bytes() : 0;
     m.lights = lights.memory_bytes();
     return m;

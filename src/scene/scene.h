@@ -17,6 +17,7 @@
 #include "bsdf/bsdf.h"
 #include "film/filter.h"
 #include "geometry/analytic.h"
+#include "geometry/instance.h"
 #include "geometry/mesh.h"
 #include "integrator/desc.h"
 #include "light/area.h"
@@ -55,6 +56,8 @@ struct SceneDescription {
     Mesh mesh;
     std::vector<Shape> shapes;
     std::vector<AnalyticShape> analytic;  // spheres, disks, cylinders (Shape::analytic indexes it)
+    std::vector<ShapeGroup> groups;       // shapegroups (Shape::group indexes it), seen only through
+    std::vector<Instance> instances;      // instances (Instance::group indexes groups)
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
     Camera camera;
@@ -75,7 +78,9 @@ struct Geometry {
     Mesh mesh;
     std::vector<Shape> shapes;
     std::vector<AnalyticShape> analytic;
-    AABB bounds;
+    std::vector<ShapeGroup> groups;
+    std::vector<Instance> instances;
+    AABB bounds;  // world: the scene's own primitives and every instance
 };
 
 class Scene {
@@ -87,6 +92,8 @@ public:
     const Mesh& mesh;                  // geometry->mesh
     const std::vector<Shape>& shapes;  // geometry->shapes
     const std::vector<AnalyticShape>& analytic;  // geometry->analytic
+    const std::vector<ShapeGroup>& groups;       // geometry->groups
+    const std::vector<Instance>& instances;      // geometry->instances
     const std::shared_ptr<const Accel> accel;
     const std::shared_ptr<const LightSet> light_set;
     const LightSet& lights;            // *light_set
@@ -111,7 +118,10 @@ public:
     SceneParams params() const { return {camera, settings, materials, emitters}; }
 
     // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
-    // of the point.
+    // of the point. In an instance (hit.instance set) the group-space interaction is taken to
+    // world space: p by to_world with its error bound carried through the transform (pbrt-v4
+    // Point3fi), ng and ns by the inverse transpose and renormalised (as Mitsuba's Instance: a
+    // mirroring to_world does not turn them around), uv unchanged.
     SurfaceInteraction interaction(const Hit& hit) const;
     // The vertex colours interpolated at a hit (Mitsuba's mesh attribute "vertex_color", what a
     // mesh_attribute texture reads); zero on a shape without colours. Apart from interaction() so
@@ -128,8 +138,9 @@ public:
     // What the scene holds in memory, by part. The mesh stores normals only where the file gives
     // them and the light maps only when there are emitters, so a scene pays for what it uses.
     struct Memory {
-        size_t triangles = 0;
-        size_t mesh = 0, accel = 0, lights = 0;  // bytes
+        size_t triangles = 0;   // stored: the scene's own plus each group's once
+        size_t instances = 0;
+        size_t mesh = 0, accel = 0, lights = 0;  // bytes (mesh: every stored mesh, plus the instances)
         size_t total() const { return mesh + accel + lights; }
     };
     Memory memory() const;

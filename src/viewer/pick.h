@@ -12,7 +12,9 @@ struct PickResult {
     vec3 normal{0.f};    // shading normal
     float distance = 0.f;
     uint32_t shape = ~0u, material = ~0u;
-    uint32_t triangle = ~0u;              // the triangle hit, ~0u on an analytic shape
+    uint32_t triangle = ~0u;              // the triangle hit, ~0u on an analytic shape (in an
+                                          // instance: the triangle of its group's mesh)
+    uint32_t instance = ~0u;              // the instance hit (Scene::instances), ~0u outside them
     PrimKind kind = PrimKind::Triangle;   // what was hit: a triangle, or a sphere, disk or cylinder
     vec2 uv{0.f};                         // analytic shapes: Mitsuba's (u, v) there
     int32_t emitter = -1;
@@ -40,6 +42,7 @@ inline PickResult pick(const Scene& scene, const Camera& camera, vec2 film_pos) 
     r.kind = hit.kind;
     r.triangle = hit.kind == PrimKind::Triangle ? hit.prim : ~0u;
     r.uv = si.uv;
+    r.instance = hit.instance;
     r.emitter = shape.emitter;
     return r;
 }

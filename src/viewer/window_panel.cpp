@@ -192,6 +192,8 @@ void Viewer::panel_pick() {
     static const char* const kKinds[] = {"triangle", "sphere", "disk", "cylinder"};
     if (pick.kind == PrimKind::Triangle) ImGui::Text("triangle  %u", pick.triangle);
     else ImGui::Text("%s  uv %.4f %.4f", kKinds[int(pick.kind)], pick.uv.x, pick.uv.y);
+    if (pick.instance != ~0u)
+        ImGui::Text("instance  %u of group %u", pick.instance, fe_->scene().instances[pick.instance].group);
     if (pick.material < fe_->params().materials.size()) {
         const Material& m = fe_->params().materials[pick.material];
         ImGui::Text("material  %s (%s)", m.name.c_str(), bsdf_type_name(m.bsdf));

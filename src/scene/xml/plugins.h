@@ -26,6 +26,9 @@ struct ShapeGeometry {
 using ShapeFactory = ShapeGeometry (*)(XmlLoader&, Object&);
 const PluginTable<ShapeFactory>& shape_plugins();
 void load_shape(XmlLoader& L, pugi::xml_node n);
+// shapegroup and instance (src/scene/xml/instancing.cpp), called by load_shape.
+void load_shapegroup(XmlLoader& L, Object& o);
+void load_instance(XmlLoader& L, Object& o);
 
 // ---- emitters.cpp: <emitter> nested in a shape (area), and top-level emitters ----
 using AreaEmitterFactory = AreaEmitter (*)(XmlLoader&, Object&);

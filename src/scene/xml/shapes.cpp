@@ -1,5 +1,6 @@
 // The shape family of the XML reader: triangle shapes (obj, rectangle, cube, and the mesh files
-// ply and serialized, read by src/shapes/) placed in world space with their bsdf and area emitter.
+// ply and serialized, read by src/shapes/) and analytic shapes placed in world space with their
+// bsdf and area emitter; shapegroup and instance (xml/instancing.cpp).
 #include <glm/glm.hpp>
 #include <fstream>
 #include "scene/obj.h"
@@ -142,8 +143,11 @@ const PluginTable<ShapeFactory>& shape_plugins() {
 
 void load_shape(XmlLoader& L, pugi::xml_node n) {
     Object o = L.read_object(n, "shape");
+    if (o.type == "shapegroup") return load_shapegroup(L, o);
+    if (o.type == "instance") return load_instance(L, o);
     const bool analytic = is_analytic_shape_type(o.type);  // intersected exactly, not tessellated
-    ShapeFactory make = analytic ? nullptr : L.find_plugin(shape_plugins(), o, ", sphere, disk, cylinder");
+    ShapeFactory make =
+        analytic ? nullptr : L.find_plugin(shape_plugins(), o, ", sphere, disk, cylinder, shapegroup, instance");
     ++L.shape_counter;
     mat4 m = o.params.get_transform("to_world", mat4(1.f));
     bool flip = o.params.get_bool("flip_normals", false);
