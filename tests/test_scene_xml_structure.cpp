@@ -298,3 +298,27 @@ TEST(SceneXmlStructure, SpectrumIntegrationIdentities) {
     EXPECT_EQ(xml::cie1931_xyz(831.0), vec3(0.f));
     EXPECT_NEAR(xml::cie_d65(560.0), 1.0101273, 1e-6);
 }
+
+// A shape may <ref> a top-level area emitter by id, as Mitsuba's own scenes do (the cbox
+// "fragments" scene): the shape emits, and its default bsdf is the black one of an emitter.
+TEST(SceneXmlStructure, ShapesReferenceAreaEmittersById) {
+    const std::string d = test_dir();
+    write(d + "ok.xml", scene("<shape type=\"rectangle\"><ref id=\"lamp\"/></shape>\n"
+                              "<emitter type=\"area\" id=\"lamp\"><rgb name=\"radiance\" value=\"2, 3, 4\"/></emitter>\n"
+                              "<shape type=\"rectangle\"><ref id=\"white\"/><ref name=\"emitter\" id=\"lamp\"/></shape>\n"
+                              "<bsdf type=\"diffuse\" id=\"white\"/>\n"));
+    SceneDescription s = load_mitsuba_xml(d + "ok.xml", {});
+    ASSERT_EQ(s.shapes.size(), 2u);
+    ASSERT_EQ(s.emitters.size(), 2u);
+    for (const Shape& sh : s.shapes) {
+        ASSERT_GE(sh.emitter, 0);
+        EXPECT_EQ(s.emitters[size_t(sh.emitter)].radiance, vec3(2.f, 3.f, 4.f));
+    }
+    expect_rgb(reflectance(s, 0), vec3(0.f), 0.f);    // emits, no bsdf: black
+    expect_rgb(reflectance(s, 1), vec3(0.5f), 0.f);   // its own bsdf
+    write(d + "bare.xml", scene("<emitter type=\"area\"/>\n"));
+    expect_error(d + "bare.xml", d + "bare.xml:2: ", "must be nested inside a <shape> or referenced by one");
+    write(d + "two.xml", scene("<emitter type=\"area\" id=\"lamp\"/>\n"
+                               "<shape type=\"rectangle\"><emitter type=\"area\"/><ref id=\"lamp\"/></shape>\n"));
+    expect_error(d + "two.xml", d + "two.xml:3: ", "a shape takes one emitter");
+}

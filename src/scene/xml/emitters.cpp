@@ -35,8 +35,9 @@ int32_t load_shape_emitter(XmlLoader& L, pugi::xml_node n) {
 }
 
 void load_emitter(XmlLoader& L, pugi::xml_node n) {
+    if (L.attr(n, "type") == "area" && n.attribute("id")) return;  // built by the shapes that <ref> it
     Object e = L.read_object(n, "emitter");
-    if (e.type == "area") throw L.error(n, "an area emitter must be nested inside a <shape>");
+    if (e.type == "area") throw L.error(n, "an area emitter must be nested inside a <shape> or referenced by one");
     throw L.error(n, "unsupported emitter type '" + e.type + "' (candela supports area emitters on shapes)");
 }
 

@@ -767,7 +767,13 @@ Material XmlLoader::nested_bsdf(Object& wrapper) {
 uint32_t XmlLoader::material_for(Object& shape) {
     int found = -1;
     pugi::xml_node first;
+    // A shape's refs name its bsdf or its area emitter (Mitsuba allows both); the emitter is the
+    // shape family's to build.
+    auto refers_to_emitter = [&](const Nested& c) {
+        return c.tag == "ref" && object_by_id(c.node, required_attr(c.node, "id"), "").tag == "emitter";
+    };
     for (Nested& c : shape.nested) {
+        if (refers_to_emitter(c)) continue;
         if (c.tag == "ref") definition(c, "bsdf");
         else if (c.tag != "bsdf") continue;
         if (found >= 0) throw error(c.node, "a shape takes one bsdf (another was given at line " + std::to_string(line(first)) + ")");
@@ -783,7 +789,7 @@ uint32_t XmlLoader::material_for(Object& shape) {
         // Mitsuba gives such a shape a diffuse BSDF with reflectance 0.5, or 0 when it emits
         // (Shape::Shape in Mitsuba 3; checked against 3.9.1): a bare light does not scatter.
         bool emits = false;
-        for (const Nested& c : shape.nested) emits = emits || c.tag == "emitter";
+        for (const Nested& c : shape.nested) emits = emits || c.tag == "emitter" || refers_to_emitter(c);
         scene_.materials.push_back({"default", DiffuseBsdf{vec3(emits ? 0.f : 0.5f)}, false});
         found = int(scene_.materials.size() - 1);
     }

@@ -157,9 +157,10 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
 
     int32_t emitter = -1;
     for (Nested& c : o.nested) {
-        if (c.tag != "emitter") continue;
+        const bool ref = c.tag == "ref" && L.object_by_id(c.node, L.required_attr(c.node, "id"), "").tag == "emitter";
+        if (c.tag != "emitter" && !ref) continue;
         if (emitter >= 0) throw L.error(c.node, "a shape takes one emitter");
-        emitter = load_shape_emitter(L, c.node);
+        emitter = load_shape_emitter(L, ref ? L.definition(c, "emitter") : c.node);
         c.used = true;
     }
     L.finish(o);
