@@ -195,18 +195,7 @@ TEST(Cameras, CropIsTheWindowOfTheFullFilmBitForBit) {
 
 namespace {
 
-ImageEstimate load_reference(const std::string& name) {
-    Image mean = read_linear_image(kData + name + "_mean.exr");
-    Image var = read_linear_image(kData + name + "_var.exr");
-    ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+ImageEstimate load_reference(const std::string& name) { return ImageEstimate::from_reference_files(kData + name); }
 
 ImageEstimate render_batches(const SceneDescription& desc) {
     const int batches = 8, spp = 256;

@@ -30,18 +30,7 @@ namespace {
 
 constexpr double kAlpha = 0.01;
 
-ImageEstimate load_reference(const std::string& prefix) {
-    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/" + prefix + "_mean.exr");
-    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/" + prefix + "_var.exr");
-    ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+ImageEstimate load_reference(const std::string& prefix) { return ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/" + prefix); }
 
 std::string filter_scene() { return std::string(CANDELA_TEST_DATA) + "/scenes/cbox_filter.xml"; }
 

@@ -28,18 +28,7 @@ namespace {
 constexpr int kRes = 64;
 constexpr double kAlpha = 0.01;
 
-ImageEstimate load_reference() {
-    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/cornell64_mean.exr");
-    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/cornell64_var.exr");
-    ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+ImageEstimate load_reference() { return ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/cornell64"); }
 
 ImageEstimate render_candela(float white_scale) {
     SceneDescription scene = make_cornell_box();
@@ -58,24 +47,6 @@ ImageEstimate render_candela(float white_scale) {
         ptrs.push_back(films.back().get());
     }
     return ImageEstimate::from_batches(ptrs);
-}
-
-// Whole-image mean per channel: z of the difference, using both images' variances.
-double whole_image_p(const ImageEstimate& a, const ImageEstimate& b, dvec3* rel_diff) {
-    dvec3 ma(0.0), mb(0.0), v(0.0);
-    const double n = double(a.mean.size());
-    for (size_t i = 0; i < a.mean.size(); ++i) {
-        ma += a.mean[i];
-        mb += b.mean[i];
-        v += a.var_of_mean[i] + b.var_of_mean[i];
-    }
-    ma /= n;
-    mb /= n;
-    v /= n * n;
-    double p_min = 1;
-    for (int c = 0; c < 3; ++c) p_min = std::min(p_min, normal_two_sided_p((ma[c] - mb[c]) / std::sqrt(v[c])));
-    if (rel_diff) *rel_diff = (ma - mb) / mb;
-    return sidak_adjust(p_min, 3);
 }
 
 }  // namespace

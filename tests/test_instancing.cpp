@@ -227,18 +227,7 @@ TEST(Instancing, XmlBadInputIsOneLineWithFileAndLine) {
 
 namespace {
 
-ImageEstimate load_reference() {
-    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/instancing32_mean.exr");
-    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/instancing32_var.exr");
-    ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+ImageEstimate load_reference() { return ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/instancing32"); }
 
 ImageEstimate render(float light_scale) {
     auto built = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/instancing.xml", {{"res", "32"}}));

@@ -147,18 +147,7 @@ TEST(Direct, AgreesWithPathAtDepthOne) {
 
 namespace {
 
-ImageEstimate load_reference(const std::string& prefix) {
-    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/" + prefix + "_mean.exr");
-    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/" + prefix + "_var.exr");
-    ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+ImageEstimate load_reference(const std::string& prefix) { return ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/" + prefix); }
 
 // K batches of `spp` samples with seeds 1..K of an XML test scene.
 ImageEstimate render_batches(const std::string& scene_file, const Defines& defines, int batches, int spp) {

@@ -792,18 +792,7 @@ TEST(MeshShapes, BadMeshFilesThroughTheProgram) {
 
 namespace {
 
-stats::ImageEstimate load_estimate(const std::string& prefix) {
-    Image mean = read_linear_image(prefix + "_mean.exr");
-    Image var = read_linear_image(prefix + "_var.exr");
-    stats::ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
-}
+stats::ImageEstimate load_estimate(const std::string& prefix) { return stats::ImageEstimate::from_reference_files(prefix); }
 
 stats::ImageEstimate render_mesh_scene(const std::function<void(SceneDescription&)>& edit) {
     SceneDescription desc = load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/mesh_formats.xml",
@@ -820,19 +809,6 @@ stats::ImageEstimate render_mesh_scene(const std::function<void(SceneDescription
         ptrs.push_back(films.back().get());
     }
     return stats::ImageEstimate::from_batches(ptrs);
-}
-
-double whole_image_p(const stats::ImageEstimate& a, const stats::ImageEstimate& b) {
-    // Sums over the image: z of the difference of the two totals, with both variances.
-    dvec3 ma(0.0), mb(0.0), v(0.0);
-    for (size_t i = 0; i < a.mean.size(); ++i) {
-        ma += a.mean[i];
-        mb += b.mean[i];
-        v += a.var_of_mean[i] + b.var_of_mean[i];
-    }
-    double p_min = 1;
-    for (int c = 0; c < 3; ++c) p_min = std::min(p_min, stats::normal_two_sided_p((ma[c] - mb[c]) / std::sqrt(v[c])));
-    return stats::sidak_adjust(p_min, 3);
 }
 
 }  // namespace

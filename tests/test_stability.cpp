@@ -95,20 +95,6 @@ Renders render(const SceneDescription& desc, int batches, int spp, uint64_t seed
     return r;
 }
 
-// Whole-image mean per channel, z-tested between two estimates (Sidak over the channels).
-double whole_image_p(const ImageEstimate& a, const ImageEstimate& b) {
-    dvec3 ma(0.0), mb(0.0), v(0.0);
-    const double n = double(a.mean.size());
-    for (size_t i = 0; i < a.mean.size(); ++i) {
-        ma += a.mean[i];
-        mb += b.mean[i];
-        v += a.var_of_mean[i] + b.var_of_mean[i];
-    }
-    double p = 1;
-    for (int c = 0; c < 3; ++c) p = std::min(p, normal_two_sided_p((ma[c] - mb[c]) / n / std::sqrt(v[c] / (n * n))));
-    return sidak_adjust(p, 3);
-}
-
 double image_mean(const Film& f) {
     double m = 0;
     for (int y = 0; y < f.height(); ++y)

@@ -335,16 +335,7 @@ TEST(Texture, BadImageFilesAreCleanErrors) {
 namespace {
 
 candela::stats::ImageEstimate load_textured_reference() {
-    Image mean = read_linear_image(std::string(CANDELA_TEST_DATA) + "/textured48_mean.exr");
-    Image var = read_linear_image(std::string(CANDELA_TEST_DATA) + "/textured48_var.exr");
-    candela::stats::ImageEstimate e;
-    e.width = mean.width;
-    e.height = mean.height;
-    for (size_t i = 0; i < mean.rgb.size(); i += 3) {
-        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
-        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
-    }
-    return e;
+    return candela::stats::ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/textured48");
 }
 
 candela::stats::ImageEstimate render_textured(const std::vector<std::pair<std::string, std::string>>& defines) {

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include "film/film.h"
+#include "film/image_io.h"
 
 namespace candela::stats {
 
@@ -562,6 +563,38 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
         im.var_of_mean[i] = v * (K / (K - 1.0));
     }
     return im;
+}
+
+ImageEstimate ImageEstimate::from_reference_files(const std::string& prefix) {
+    Image mean = read_linear_image(prefix + "_mean.exr");
+    Image var = read_linear_image(prefix + "_var.exr");
+    if (var.width != mean.width || var.height != mean.height)
+        throw std::runtime_error(prefix + ": the mean and variance images differ in size");
+    ImageEstimate e;
+    e.width = mean.width;
+    e.height = mean.height;
+    for (size_t i = 0; i + 2 < mean.rgb.size(); i += 3) {
+        e.mean.push_back(dvec3(mean.rgb[i], mean.rgb[i + 1], mean.rgb[i + 2]));
+        e.var_of_mean.push_back(dvec3(var.rgb[i], var.rgb[i + 1], var.rgb[i + 2]));
+    }
+    return e;
+}
+
+double whole_image_p(const ImageEstimate& a, const ImageEstimate& b, dvec3* rel) {
+    dvec3 ma(0.0), mb(0.0), v(0.0);
+    const double n = double(a.mean.size());
+    for (size_t i = 0; i < a.mean.size(); ++i) {
+        ma += a.mean[i];
+        mb += b.mean[i];
+        v += a.var_of_mean[i] + b.var_of_mean[i];
+    }
+    ma /= n;
+    mb /= n;
+    v /= n * n;
+    double p_min = 1;
+    for (int c = 0; c < 3; ++c) p_min = std::min(p_min, normal_two_sided_p((ma[c] - mb[c]) / std::sqrt(v[c])));
+    if (rel) *rel = (ma - mb) / mb;
+    return sidak_adjust(p_min, 3);
 }
 
 ImageEstimate ImageEstimate::from_film(const Film& film, const std::vector<dvec3>& var_of_mean) {

@@ -175,7 +175,15 @@ struct ImageEstimate {
     static ImageEstimate from_batches(const std::vector<const Film*>& batches);
     // A committed reference: its mean image and a per-pixel variance-of-the-mean image.
     static ImageEstimate from_film(const Film& film, const std::vector<dvec3>& var_of_mean);
+    // A committed reference as tests/data/make_reference.py writes it: PREFIX_mean.exr (the mean of
+    // K batch renders) and PREFIX_var.exr (the variance of that mean), per pixel and channel.
+    static ImageEstimate from_reference_files(const std::string& prefix);
 };
+
+// Whole-image z-test per channel: the difference of the two images' means over all pixels, with
+// both images' variances (pixels independent); the smallest p, Sidak-adjusted over the channels.
+// `rel`, when given, receives (mean_a - mean_b) / mean_b per channel.
+double whole_image_p(const ImageEstimate& a, const ImageEstimate& b, dvec3* rel = nullptr);
 
 // Block z-test. Both images are cut into block x block tiles (partial tiles at the edges count).
 // Per tile and channel: m = average of the pixel means, v = sum of var_of_mean / n_pixels^2 (pixels
