@@ -16,6 +16,7 @@
 #include "sampling/pcg32.h"
 #include "sampling/warp.h"
 #include "scene/scene.h"
+#include "support/render.h"
 #include "support/stats.h"
 
 using namespace candela;
@@ -673,16 +674,7 @@ ImageEstimate render_analytic(float sphere_light_scale) {
     SceneParams p = built->params();
     for (const Shape& s : built->shapes)
         if (s.name == "sphere_light") p.emitters[size_t(s.emitter)].radiance *= sphere_light_scale;
-    const int batches = 8, spp = 128;
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
-    for (int b = 0; b < batches; ++b) {
-        films.push_back(std::make_unique<Film>(48, 48));
-        p.settings.seed = uint64_t(b + 1);
-        Renderer::render_pass(*built->with_params(p), *films.back(), 0, spp, 0);
-        ptrs.push_back(films.back().get());
-    }
-    return ImageEstimate::from_batches(ptrs);
+    return candela::test::render_batch_estimate(*built, p, 8, 128);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/cornell.h"
+#include "support/render.h"
 #include "support/stats.h"
 
 using namespace candela;
@@ -36,17 +37,7 @@ ImageEstimate render_candela(float white_scale) {
     scene.settings.width = kRes;
     scene.settings.height = kRes;
     const std::shared_ptr<const Scene> built = build_scene(scene);
-    const int batches = 8, spp = 64;
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
-    for (int b = 0; b < batches; ++b) {
-        films.push_back(std::make_unique<Film>(kRes, kRes));
-        SceneParams p = built->params();
-        p.settings.seed = uint64_t(b + 1);
-        Renderer::render_pass(*built->with_params(p), *films.back(), 0, spp, 0);
-        ptrs.push_back(films.back().get());
-    }
-    return ImageEstimate::from_batches(ptrs);
+    return candela::test::render_batch_estimate(*built, built->params(), 8, 64);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "sampling/pcg32.h"
 #include "scene/scene.h"
 #include "support/shared_assets.h"
+#include "support/render.h"
 #include "support/stats.h"
 
 using namespace candela;
@@ -234,16 +235,7 @@ ImageEstimate render(float light_scale) {
     EXPECT_EQ(built->instances.size(), 4u);
     SceneParams p = built->params();
     for (AreaEmitter& e : p.emitters) e.radiance *= light_scale;
-    const int batches = 8, spp = 128;
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
-    for (int b = 0; b < batches; ++b) {
-        films.push_back(std::make_unique<Film>(32, 32));
-        p.settings.seed = uint64_t(b + 1);
-        Renderer::render_pass(*built->with_params(p), *films.back(), 0, spp, 0);
-        ptrs.push_back(films.back().get());
-    }
-    return ImageEstimate::from_batches(ptrs);
+    return candela::test::render_batch_estimate(*built, p, 8, 128);
 }
 
 }  // namespace

@@ -30,6 +30,7 @@
 #include "scene/cornell.h"
 #include "scene/loaders.h"
 #include "support/run.h"
+#include "support/render.h"
 #include "support/stats.h"
 
 using namespace candela;
@@ -152,16 +153,7 @@ ImageEstimate load_reference(const std::string& prefix) { return ImageEstimate::
 // K batches of `spp` samples with seeds 1..K of an XML test scene.
 ImageEstimate render_batches(const std::string& scene_file, const Defines& defines, int batches, int spp) {
     const std::shared_ptr<const Scene> built = build_scene(load_scene(scene_file, defines));
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
-    for (int b = 0; b < batches; ++b) {
-        SceneParams p = built->params();
-        p.settings.seed = uint64_t(b + 1);
-        films.push_back(std::make_unique<Film>(p.settings.width, p.settings.height));
-        Renderer::render_pass(*built->with_params(p), *films.back(), 0, spp, 0);
-        ptrs.push_back(films.back().get());
-    }
-    return ImageEstimate::from_batches(ptrs);
+    return candela::test::render_batch_estimate(*built, built->params(), batches, spp);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "support/render.h"
 #include "support/stats.h"
 #include "texture/texture.h"
 
@@ -342,16 +343,7 @@ candela::stats::ImageEstimate render_textured(const std::vector<std::pair<std::s
     auto d = defines;
     d.push_back({"res", "48"});
     auto built = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/textured.xml", d));
-    SceneParams p = built->params();
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
-    for (int b = 0; b < 8; ++b) {
-        films.push_back(std::make_unique<Film>(48, 48));
-        p.settings.seed = uint64_t(b + 1);
-        Renderer::render_pass(*built->with_params(p), *films.back(), 0, 128, 0);
-        ptrs.push_back(films.back().get());
-    }
-    return candela::stats::ImageEstimate::from_batches(ptrs);
+    return candela::test::render_batch_estimate(*built, built->params(), 8, 128);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <omp.h>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 #include "film/filter.h"
 #include "integrator/aov/aov.h"
@@ -174,6 +175,25 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
     out.samples = total_samples.load();
     out.completed = !stopped.load();
     return out;
+}
+
+// A pass of a per-ray integrator (`Integrator(scene).Li<Sampler, DiffuseOnly>(ray, sampler, stats)`)
+// over all tiles, instantiated for the scene's materials: DiffuseOnly when every material is
+// diffuse. Chosen per pass, so that a material edited in the viewer (which restarts the
+// accumulation) switches the instantiation too; both give the same image, the specialisation only
+// drops code.
+template <class Integrator>
+PassStats render_integrator_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
+                                 const std::atomic<bool>* cancel) {
+    auto run = [&](auto diffuse_only) {
+        const Integrator integrator(scene);
+        return render_tiles(scene, film, first_sample, spp, n_threads, cancel,
+                            [&](IndependentSampler& sampler, Ray ray, PathStats& ps) {
+                                return integrator.template Li<IndependentSampler, decltype(diffuse_only)::value>(
+                                    ray, sampler, ps);
+                            });
+    };
+    return scene_is_diffuse_only(scene) ? run(std::true_type{}) : run(std::false_type{});
 }
 
 }  // namespace candela
