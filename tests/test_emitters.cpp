@@ -413,3 +413,25 @@ TEST(Emitters, XmlDefaultsAreMitsubas) {
     EXPECT_NEAR(glm::length(s2.position() - vec3(1, 1, 1)), 0.f, 1e-6f);
     EXPECT_NEAR(glm::length(s2.axis() - vec3(0, 1, 0)), 0.f, 1e-6f);  // Mitsuba's lookat points +z at the target
 }
+
+TEST(Emitters, EditingALightRebuildsTheLightSetOnly) {
+    // The viewer's path: SceneParams edited, Scene::with_params. The geometry and the accelerator
+    // are shared; the light set is rebuilt when a light changed and shared when nothing did.
+    auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/emitter_spot.xml", {{"res", "8"}}));
+    SceneParams p = sc->params();
+    ASSERT_EQ(p.lights.size(), 1u);
+    auto same = sc->with_params(p);
+    EXPECT_EQ(same->light_set, sc->light_set);
+    light_strength(p.lights[0].model) *= 2.f;
+    auto edited = sc->with_params(p);
+    EXPECT_EQ(edited->geometry, sc->geometry);
+    EXPECT_EQ(edited->accel, sc->accel);
+    EXPECT_NE(edited->light_set, sc->light_set);
+    LightSample a, b;
+    ASSERT_TRUE(sc->lights.sample_li(vec3(0, 0.3f, 0), 0.5f, vec2(0.5f), a));
+    ASSERT_TRUE(edited->lights.sample_li(vec3(0, 0.3f, 0), 0.5f, vec2(0.5f), b));
+    EXPECT_FLOAT_EQ(b.Le.x, 2.f * a.Le.x);
+    // A negative strength from an edit is refused like one from a file.
+    light_strength(p.lights[0].model) = vec3(-1.f);
+    EXPECT_THROW(sc->with_params(p), Error);
+}
