@@ -235,7 +235,10 @@ TEST(SceneXml, TransformOps) {
     // Right-handed: 90 degrees about +z takes +x to +y.
     expect_transform("<rotate z=\"1\" angle=\"90\"/>", rows({0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}));
     expect_transform("<rotate x=\"1\" angle=\"90\"/>", rows({1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1}));
-    expect_transform("<rotate value=\"0 2 0\" angle=\"180\"/>", rows({-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1}));
+    // A non-unit axis is used as given, as Mitsuba 3.9 (c I + s [a]x + (1 - c) a a^T; values printed by
+    // mi.ScalarTransform4f().rotate([0, 1, 1], 90) and rotate([0, 2, 0], 180)).
+    expect_transform("<rotate value=\"0 2 0\" angle=\"180\"/>", rows({-1, 0, 0, 0, 0, 7, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1}));
+    expect_transform("<rotate x=\"0\" y=\"1\" z=\"1\" angle=\"90\"/>", rows({0, -1, 1, 0, 1, 1, 1, 0, -1, 1, 1, 0, 0, 0, 0, 1}));
     expect_transform("<matrix value=\"2 1 0 4  0 3 1 5  1 0 2 6  0 0 0 1\"/>",
                      rows({2, 1, 0, 4, 0, 3, 1, 5, 1, 0, 2, 6, 0, 0, 0, 1}));
     expect_transform("<matrix value=\"0 -1 0  1 0 0  0 0 1\"/>", rows({0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}));
