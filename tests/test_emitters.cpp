@@ -361,6 +361,55 @@ TEST(Emitters, MitsubaAgreement) {
     }
 }
 
+// A textured area radiance (a checkerboard on a rectangle that faces the camera) against Mitsuba:
+// the pattern is seen directly and in the light on the floor. Control: the same emitter with a
+// constant radiance equal to the texture's mean must be rejected, so the test sees the texture.
+TEST(Emitters, TexturedAreaRadianceMatchesMitsuba) {
+    ImageEstimate ref = ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/emitter_textured_area");
+    ASSERT_EQ(ref.width, 32);
+    auto built = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/emitter_textured_area.xml", {{"res", "32"}}));
+    SceneParams p = built->params();
+    ASSERT_EQ(p.emitters.size(), 1u);
+    ASSERT_TRUE(p.emitters[0].texture);
+    ImageEstimate test = candela::test::render_batch_estimate(*built, p, 8, 64);
+    BlockTestResult r = block_z_test(test, ref, 8, kAlpha);
+    dvec3 rel;
+    double pw = whole_image_p(test, ref, &rel);
+    std::printf("  textured area blocks: %s\n                whole image: p = %.3g, relative (%.4f, %.4f, %.4f)\n",
+                r.describe().c_str(), pw, rel.x, rel.y, rel.z);
+    EXPECT_TRUE(r.passed(kAlpha)) << r.describe();
+    EXPECT_GE(pw, kAlpha);
+    // Control: the checkerboard's two colours in equal parts, as a constant.
+    p.emitters[0].radiance = 0.5f * (vec3(1.f, 0.85f, 0.6f) + vec3(0.08f, 0.15f, 0.4f));
+    p.emitters[0].texture = nullptr;
+    ImageEstimate flat = candela::test::render_batch_estimate(*built, p, 8, 64);
+    EXPECT_FALSE(block_z_test(flat, ref, 8, kAlpha).passed(kAlpha)) << "a constant radiance passed for the texture";
+}
+
+TEST(Emitters, TexturedRadianceErrors) {
+    const std::string dir = test::temp_dir("emitters-textured-bad");
+    auto expect_error = [&](const std::string& shape, const std::string& needle) {
+        const std::string path = dir + "/scene.xml";
+        test::write_text(path, "<scene version=\"3.0.0\">\n" + shape + "\n</scene>\n");
+        try {
+            load_scene(path);
+            ADD_FAILURE() << "no error for " << shape;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("scene.xml:"), std::string::npos) << e.what();
+        }
+    };
+    const std::string checker = "<texture type=\"checkerboard\" name=\"radiance\"/>";
+    expect_error("<shape type=\"sphere\"><emitter type=\"area\">" + checker + "</emitter></shape>",
+                 "supported on meshes only");
+    expect_error("<shape type=\"rectangle\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/>" + checker +
+                     "</emitter></shape>",
+                 "both as a value and as a texture");
+    expect_error("<shape type=\"rectangle\"><emitter type=\"area\"><texture type=\"mesh_attribute\" name=\"radiance\">"
+                 "<string name=\"name\" value=\"vertex_color\"/></texture></emitter></shape>",
+                 "vertex colours");
+}
+
 // ---- bad input -----------------------------------------------------------------------------------
 
 TEST(Emitters, BadInputIsOneLineWithFileAndLine) {

@@ -322,6 +322,14 @@ TEST(Texture, BadImageFilesAreCleanErrors) {
     std::string good = candela::test::read_bytes(data_file("rgb3x2.png"));
     candela::test::write_text(dir + "/truncated.png", good.substr(0, good.size() / 2));
     expect_error(dir + "/truncated.png", "truncated.png");
+    // A JPEG whose Huffman code counts sum to more than 256 (found by tests/fuzz/fuzz_image.cpp: Debian
+    // 12's stb_image writes past its table there) is refused before stb_image sees it; a good JPEG
+    // still decodes.
+    expect_error(data_file("bad_huffman.jpg"), "corrupt JPEG Huffman table");
+    auto jpg = load_texels(data_file("rgb2x2.jpg"), false);
+    EXPECT_EQ(jpg->width, 2);
+    EXPECT_EQ(jpg->height, 2);
+    EXPECT_EQ(jpg->channels, 3);
 }
 
 // ---- textured materials in a render, against Mitsuba -------------------------------------------

@@ -3,10 +3,51 @@
 
 namespace candela {
 
+namespace {
+
+// The radiance a textured emitter stands for in light selection: its mean over a 64 x 64 grid of
+// uv, floored at a small fraction of the largest value seen so that no part of a texture that
+// emits somewhere gets a zero pmf (any positive weight keeps the estimate unbiased; the mean only
+// makes it efficient).
+vec3 textured_weight_radiance(const Texture& t) {
+    constexpr int kN = 64;
+    dvec3 sum(0.0);
+    float peak = 0.f;
+    TextureQuery q;
+    for (int j = 0; j < kN; ++j)
+        for (int i = 0; i < kN; ++i) {
+            q.uv = vec2((float(i) + 0.5f) / kN, (float(j) + 0.5f) / kN);
+            vec3 v = t.eval(q);
+            sum += dvec3(v);
+            peak = std::max(peak, luminance(v));
+        }
+    vec3 mean = vec3(sum / double(kN * kN));
+    const float floor = std::max(1e-3f * peak, 1e-6f);
+    return luminance(mean) >= floor ? mean : vec3(floor);
+}
+
+}  // namespace
+
+vec3 LightSet::triangle_radiance(uint32_t tri, int32_t e, float b1, float b2) const {
+    const Texture* tex = emitter_texture_[size_t(e)];
+    if (!tex) return emitter_radiance_[size_t(e)];
+    TextureQuery q;
+    const Shape& shape = (*shapes_)[mesh_->tri_shape[tri]];
+    if (shape.has_uv()) {
+        const uvec3& t = mesh_->triangles[tri];
+        const vec2* uv = mesh_->uvs.data() + shape.uv_offset - shape.first_vertex;
+        q.uv = (1.f - b1 - b2) * uv[t.x] + b1 * uv[t.y] + b2 * uv[t.z];
+    } else {
+        q.uv = vec2(b1, b2);
+    }
+    return tex->eval(q);
+}
+
 void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters,
                      const std::vector<AnalyticShape>* analytic, const std::vector<Light>* lights,
                      const AABB& bounds) {
     mesh_ = &mesh;
+    shapes_ = &shapes;
     analytic_ = analytic;
     alights_.clear();
     analytic_light_.clear();
@@ -18,10 +59,14 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
     tri_emitter_.clear();
     emitter_radiance_.clear();
     std::vector<float> weights;
-    for (const AreaEmitter& e : emitters) emitter_radiance_.push_back(e.radiance);
+    emitter_texture_.clear();
+    for (const AreaEmitter& e : emitters) {
+        emitter_radiance_.push_back(e.texture ? textured_weight_radiance(*e.texture) : e.radiance);
+        emitter_texture_.push_back(e.texture.get());
+    }
     for (const Shape& s : shapes) {
         if (s.emitter < 0) continue;
-        vec3 L = emitters[size_t(s.emitter)].radiance;
+        vec3 L = emitter_radiance_[size_t(s.emitter)];
         if (prim_light_.empty()) {
             prim_light_.assign(mesh.triangles.size(), -1);
             tri_emitter_.assign(mesh.triangles.size(), -1);
@@ -144,7 +189,9 @@ bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) c
     float cos_light = -glm::dot(out.wi, ng);
     if (glm::dot(out.wi, ns) >= 0.f || cos_light == 0.f) return false;  // we see its back
     out.n = ng;
-    out.Le = radiance_[i];
+    // interpolate_point weighs p0, p1, p2 by (b.x, b.y, 1 - b.x - b.y).
+    out.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
+                                                         : radiance_[i];
     out.pdf = pmf / area_[i] * dist2 / std::abs(cos_light);
     return std::isfinite(out.pdf) && out.pdf > 0.f;
 }
@@ -175,6 +222,11 @@ vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
     if (tri_emitter_.empty()) return vec3(0.f);
     int32_t e = tri_emitter_[on_light.prim];
     if (e < 0 || glm::dot(w, on_light.ns) <= 0.f) return vec3(0.f);
+    if (const Texture* tex = emitter_texture_[size_t(e)]) {
+        TextureQuery q;
+        q.uv = on_light.uv;
+        return tex->eval(q);
+    }
     return emitter_radiance_[size_t(e)];
 }
 
@@ -227,7 +279,8 @@ std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 
             if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
         }
         area = area_[i];
-        es.Le = radiance_[i];
+        es.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
+                                                            : radiance_[i];
     }
     // Cosine-distributed about the emitting side (the shading normal's, as emitted()).
     vec3 local = square_to_cosine_hemisphere(u_dir);

@@ -1,17 +1,21 @@
 #pragma once
+#include <memory>
 #include <vector>
 #include "geometry/analytic.h"
 #include "geometry/interaction.h"
 #include "geometry/mesh.h"
 #include "light/emitter.h"
+#include "texture/texture.h"
 #include "sampling/distribution.h"
 
 namespace candela {
 
-// An area emitter attached to a shape: constant radiance, emitted on the side the shading normal
-// points to (one-sided, as Mitsuba 3's `area`).
+// An area emitter attached to a shape: radiance emitted on the side the shading normal points to
+// (one-sided, as Mitsuba 3's `area`). A textured radiance (Mitsuba's nested texture) is evaluated
+// at the uv of each point, on triangle meshes; `radiance` is then not used.
 struct AreaEmitter {
     vec3 radiance{0.f};
+    std::shared_ptr<const Texture> texture;
 };
 
 // Every light of the scene: the emissive triangles and analytic shapes, and the emitters that are
@@ -91,7 +95,8 @@ public:
                tri_emitter_.capacity() * sizeof(int32_t) + emitter_radiance_.capacity() * sizeof(vec3) +
                alights_.capacity() * sizeof(uint32_t) + analytic_light_.capacity() * sizeof(int32_t) +
                analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes() +
-               lights_.capacity() * sizeof(Light) + infinite_.capacity() * sizeof(uint32_t);
+               lights_.capacity() * sizeof(Light) + infinite_.capacity() * sizeof(uint32_t) +
+               emitter_texture_.capacity() * sizeof(const Texture*);
     }
 
 private:
@@ -102,6 +107,11 @@ private:
     std::vector<int32_t> prim_light_;     // triangle id -> index into tris_, or -1
     std::vector<int32_t> tri_emitter_;    // triangle id -> emitter index, or -1
     std::vector<vec3> emitter_radiance_;
+    std::vector<const Texture*> emitter_texture_;  // per emitter, null unless textured
+    const std::vector<Shape>* shapes_ = nullptr;
+    // The radiance leaving emissive triangle `tri` (of emitter e) at barycentrics (b1, b2) of its
+    // vertices 1 and 2: the constant, or the texture at the mesh's uv there (Scene::interaction's).
+    vec3 triangle_radiance(uint32_t tri, int32_t e, float b1, float b2) const;
     // Analytic emitters: entry tris_.size() + k of dist_ is analytic shape alights_[k].
     const std::vector<AnalyticShape>* analytic_ = nullptr;
     std::vector<uint32_t> alights_;           // emissive analytic shape indices

@@ -111,7 +111,7 @@ Camera sized(Camera c, const RenderSettings& st) {
 bool same_emitters(const std::vector<AreaEmitter>& a, const std::vector<AreaEmitter>& b) {
     if (a.size() != b.size()) return false;
     for (size_t i = 0; i < a.size(); ++i)
-        if (a[i].radiance != b[i].radiance) return false;
+        if (a[i].radiance != b[i].radiance || a[i].texture != b[i].texture) return false;
     return true;
 }
 

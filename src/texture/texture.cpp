@@ -1,7 +1,10 @@
 #include "texture/texture.h"
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
@@ -25,6 +28,47 @@ float srgb_to_linear(float v) {
 }
 
 namespace {
+
+// Debian 12's stb_image builds a JPEG Huffman table without checking that its code counts sum to at
+// most 256 (fixed upstream later), and writes past the table for a corrupt file (found by
+// tests/fuzz/fuzz_image.cpp). So every DHT segment is checked here first, walking the JPEG's
+// markers, including those between the scans of a progressive file.
+bool jpeg_huffman_tables_valid(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::string b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    auto at = [&](size_t i) { return i < b.size() ? uint8_t(b[i]) : uint8_t(0); };
+    // stb_image reads past the end of a file as zeros and skips fill bytes (0xFF) before a marker;
+    // so does this walk.
+    size_t i = 0;
+    while (at(i) == 0xFF && at(i + 1) == 0xFF) ++i;
+    if (at(i) != 0xFF || at(i + 1) != 0xD8) return true;  // not a JPEG
+    i += 2;
+    while (i + 4 <= b.size()) {
+        if (at(i) != 0xFF) {  // entropy-coded data: skip to the next marker that is not a stuffed 0 or RSTn
+            ++i;
+            continue;
+        }
+        const uint8_t m = at(i + 1);
+        if (m == 0x00 || m == 0xFF || (m >= 0xD0 && m <= 0xD7) || m == 0x01) {
+            i += m == 0xFF ? 1 : 2;
+            continue;
+        }
+        if (m == 0xD9) break;  // end of image
+        const size_t len = size_t(at(i + 2)) << 8 | at(i + 3);
+        if (len < 2) return false;
+        if (m == 0xC4) {
+            size_t k = i + 4, end = i + 2 + len;
+            while (k < end && k < b.size()) {
+                size_t n = 0;
+                for (int c = 0; c < 16; ++c) n += at(k + 1 + size_t(c));
+                if (n > 256) return false;
+                k += 17 + n;
+            }
+        }
+        i += 2 + len;
+    }
+    return true;
+}
 
 // Texel index `i` of a grid `n` texels wide, wrapped by the mode (Mitsuba's, for any integer).
 int wrap_index(int i, int n, TextureWrap mode) {
@@ -98,6 +142,7 @@ std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) 
         g->data = std::move(img.rgb);
     } else {
         int w = 0, h = 0, n = 0;
+        if (!jpeg_huffman_tables_valid(path)) throw Error(path, 0, "cannot decode image: corrupt JPEG Huffman table");
         if (!stbi_info(path.c_str(), &w, &h, &n))
             throw Error(path, 0, std::string("cannot read image: ") + stbi_failure_reason());
         // Images of more than 2^28 texels would need gigabytes as floats; refuse them before

@@ -23,8 +23,14 @@ vec3 transformed_z(Object& e, const mat4& m) {
     return d / len;
 }
 
-EmitterModel make_area(XmlLoader&, Object& e) {
-    return AreaEmitter{strength(e, "radiance")};
+EmitterModel make_area(XmlLoader& L, Object& e) {
+    // A textured radiance (bitmap, checkerboard): evaluated at the uv of each emitting point.
+    std::shared_ptr<const Texture> t = nested_texture(L, e, "radiance");
+    if (!t) return AreaEmitter{strength(e, "radiance"), nullptr};
+    if (e.params.has("radiance")) throw e.params.error("radiance", "'radiance' is given both as a value and as a texture");
+    if (t->uses_vertex_colors())
+        throw L.error(e.node, "a radiance texture that reads vertex colours (mesh_attribute) is not supported");
+    return AreaEmitter{vec3(0.f), t};
 }
 
 EmitterModel make_point(XmlLoader& L, Object& e) {

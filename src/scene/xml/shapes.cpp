@@ -161,6 +161,8 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
         if (c.tag != "emitter" && !ref) continue;
         if (emitter >= 0) throw L.error(c.node, "a shape takes one emitter");
         emitter = load_shape_emitter(L, ref ? L.definition(c, "emitter") : c.node);
+        if (analytic && L.scene().emitters[size_t(emitter)].texture)
+            throw L.error(c.node, "a textured radiance is supported on meshes only, not on a " + o.type);
         c.used = true;
     }
     L.finish(o);
