@@ -374,7 +374,7 @@ TEST(SceneXml, Errors) {
     expect_error("<shape type=\"rectangle\">\n<foo/></shape>\n", 3, "unknown tag <foo>");
     expect_error("\n<bar/>\n", 3, "unknown tag <bar>");
     expect_error("<shape type=\"bsplinecurve\"/>\n", 2, "unsupported shape type 'bsplinecurve'");
-    expect_error("\n<bsdf type=\"blendbsdf\" id=\"c\"/>\n", 3, "unsupported bsdf type 'blendbsdf'");
+    expect_error("\n<bsdf type=\"blendbsdf\" id=\"c\"/>\n", 3, "blendbsdf' needs 'weight'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"measured\"/></shape>\n", 3, "unsupported bsdf type 'measured'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "needs a nested <bsdf>");
     expect_error("<integrator type=\"bdpt\"/>\n", 2, "unsupported integrator type 'bdpt'");

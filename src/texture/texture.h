@@ -53,6 +53,10 @@ struct BitmapTexture {
     std::string name;  // file name, for messages and the viewer
 
     vec3 eval(const TextureQuery& q) const;
+    // d eval_1 / d(u, v), as Mitsuba's bitmap eval_1_grad: the derivative of the bilinear
+    // interpolation of the luminance within the texel cell around uv (times the resolution and
+    // through to_uv); 0 for nearest filtering (piecewise constant).
+    vec2 eval_1_grad(const TextureQuery& q) const;
 };
 
 struct Texture;
@@ -82,6 +86,13 @@ struct Texture {
         }, v);
     }
     float eval_1(const TextureQuery& q) const { return luminance(eval(q)); }
+    // The gradient of eval_1 in uv (bumpmap's height slope). Only a bitmap varies smoothly; a
+    // constant, a checkerboard (piecewise constant) and vertex colours (not a function of uv)
+    // give 0.
+    vec2 eval_1_grad(const TextureQuery& q) const {
+        if (const BitmapTexture* b = std::get_if<BitmapTexture>(&v)) return b->eval_1_grad(q);
+        return vec2(0.f);
+    }
     bool is_constant() const { return std::holds_alternative<ConstantTexture>(v); }
     // Whether it reads the mesh's vertex colours (the mesh must then store them).
     bool uses_vertex_colors() const;
