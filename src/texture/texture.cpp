@@ -72,6 +72,12 @@ vec3 BitmapTexture::eval(const TextureQuery& q) const {
     return (1.f - wy) * v0 + wy * v1;
 }
 
+float CheckerboardTexture::eval_1(const TextureQuery& q) const {
+    vec2 uv = to_uv.apply(q.uv);
+    const bool mu = uv.x - std::floor(uv.x) > 0.5f, mv = uv.y - std::floor(uv.y) > 0.5f;
+    return mu == mv ? color1->eval_1(q) : color0->eval_1(q);
+}
+
 vec2 BitmapTexture::eval_1_grad(const TextureQuery& q) const {
     if (filter == TextureFilter::Nearest) return vec2(0.f);
     const TexelGrid& g = *texels;
