@@ -7,7 +7,8 @@
 // materials never build one: the integrators call the leaf BSDF directly (integrator/shading.h).
 //
 // Contract (as bsdf.h): wo, wi are unit vectors in the integrator's local shading frame (the
-// unperturbed one, n = +z); eval = f |cos theta_i| relative to that frame's normal... precisely:
+// unperturbed one, n = +z); eval_w = f |cos theta_i| with the cosine the leaves take in their own
+// (possibly perturbed) frame, pdf_w in solid angle, sample_w's weight = f |cos| / pdf:
 //   blend:    eval = sum_k w_k eval_k,  pdf = sum_k w_k pdf_k (solid angle). sample picks leaf k with
 //             probability w_k (u1 rescaled into the leaf), samples it, and for a non-delta direction
 //             returns the whole mixture's eval and pdf at that direction (so sample, pdf and eval
