@@ -29,8 +29,8 @@ constexpr int kMaxBlendLeaves = 8;
 
 struct WrappedBsdf {
     int n = 0;                                   // number of leaves with weight > 0
-    std::array<const Bsdf*, kMaxBlendLeaves> leaf{};
-    std::array<float, kMaxBlendLeaves> w{};      // mixture weights, sum 1
+    std::array<const Bsdf*, kMaxBlendLeaves> leaf;  // the first n are set
+    std::array<float, kMaxBlendLeaves> w;        // mixture weights of the first n, sum 1
     bool perturbed = false;
     Frame frame;                                 // the perturbed frame, local coordinates
     bool terminator = false;

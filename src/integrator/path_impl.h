@@ -35,7 +35,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                                  // probabilities of the mask pass-throughs since)
     vec3 prev_p(0.f);
     float eta_scale = 1.f;       // product of eta^2 over refractions: undoes their radiance scaling
-    Shading sh;
+    ShadingT<DiffuseOnly> sh;
     int passes = 0;              // mask pass-throughs (bounded, as skip_area_emitters)
 
     for (int depth = 0;; ++depth) {
@@ -77,19 +77,19 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         shade<DiffuseOnly>(sc, hit, si, wo_world, sh);
 
         // Next-event estimation.
-        if (mode != SamplingMode::Bsdf && have_lights && sh.template has_smooth_component<DiffuseOnly>()) {
+        if (mode != SamplingMode::Bsdf && have_lights && sh.has_smooth_component()) {
             float ul = sampler.next_1d();
             vec2 up = sampler.next_2d();
             LightSample ls;
             if (sc.lights.sample_li(si.p, ul, up, ls)) {
                 vec3 wi = sh.frame.to_local(ls.wi);
-                vec3 f = sh.template eval<DiffuseOnly>(wi);
+                vec3 f = sh.eval(wi);
                 if (!is_black(f)) {
                     Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
                     ++stats.rays;
                     const float T = shadow_transmittance(sc, shadow, !DiffuseOnly && masks_, stats.rays);
                     if (T > 0.f) {
-                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, sh.template pdf<DiffuseOnly>(wi) * T) : 1.f;
+                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, sh.pdf(wi) * T) : 1.f;
                         L += beta * f * ls.Le * (T * w / ls.pdf);
                     }
                 }
@@ -103,7 +103,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         // Continue the path by sampling the BSDF.
         float u1 = sampler.next_1d();
         vec2 u2 = sampler.next_2d();
-        std::optional<BsdfSample> bs = sh.template sample<DiffuseOnly>(u1, u2);
+        std::optional<BsdfSample> bs = sh.sample(u1, u2);
         if (!bs || !(bs->pdf > 0.f)) break;
         beta *= bs->weight();
         if (is_black(beta)) break;

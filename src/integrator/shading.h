@@ -18,34 +18,32 @@
 namespace candela {
 
 // What a hit resolves to. Holds the textured copies of the BSDFs, so it lives as long as they are
-// used (one per bounce; construct once per path and reuse).
-struct Shading {
+// used (one per bounce; construct once per path and reuse). The diffuse-only instantiation holds
+// room for one copy only: a plain diffuse scene builds nothing it does not use.
+template <bool DiffuseOnly>
+struct ShadingT {
     Frame frame;
     vec3 wo{0.f};
     const Bsdf* bsdf = nullptr;     // the plain material's BSDF (textured copy in scratch[0])
     bool is_wrapped = false;
     WrappedBsdf wrapped;
-    std::array<Bsdf, kMaxBlendLeaves> scratch;
+    std::array<Bsdf, DiffuseOnly ? 1 : kMaxBlendLeaves> scratch;
 
-    template <bool DiffuseOnly>
     vec3 eval(vec3 wi, TransportMode mode = TransportMode::Radiance) const {
         if constexpr (!DiffuseOnly)
             if (is_wrapped) return wrapped.eval_w(wo, wi, mode);
         return eval_in<DiffuseOnly>(*bsdf, wo, wi, mode);
     }
-    template <bool DiffuseOnly>
     float pdf(vec3 wi, TransportMode mode = TransportMode::Radiance) const {
         if constexpr (!DiffuseOnly)
             if (is_wrapped) return wrapped.pdf_w(wo, wi, mode);
         return pdf_in<DiffuseOnly>(*bsdf, wo, wi, mode);
     }
-    template <bool DiffuseOnly>
     std::optional<BsdfSample> sample(float u1, vec2 u2, TransportMode mode = TransportMode::Radiance) const {
         if constexpr (!DiffuseOnly)
             if (is_wrapped) return wrapped.sample_w(wo, u1, u2, mode);
         return sample_in<DiffuseOnly>(*bsdf, wo, u1, u2, mode);
     }
-    template <bool DiffuseOnly>
     bool has_smooth_component() const {
         if constexpr (!DiffuseOnly)
             if (is_wrapped) return wrapped.has_smooth_w();
@@ -56,7 +54,7 @@ struct Shading {
 namespace detail {
 
 // Adds the leaves under blend child `c` with mixture weight `w` (depth-first, leaf order).
-inline void add_blend_leaves(const Material& m, const TextureQuery& q, int c, float w, Shading& sh) {
+inline void add_blend_leaves(const Material& m, const TextureQuery& q, int c, float w, ShadingT<false>& sh) {
     WrappedBsdf& wb = sh.wrapped;
     if (c >= 0) {
         const BlendNode& b = m.blend[size_t(c)];
@@ -76,24 +74,9 @@ inline void add_blend_leaves(const Material& m, const TextureQuery& q, int c, fl
 
 }  // namespace detail
 
-// Resolves the material at a hit. `si.ng` is turned with the frame for two-sided materials (the
-// ray offsets use it). `wo_world` points towards the previous vertex.
-template <bool DiffuseOnly>
-inline void shade(const Scene& sc, const Hit& hit, SurfaceInteraction& si, vec3 wo_world, Shading& sh) {
-    const Material& mat = sc.materials[sc.shapes[si.shape].material];
-    vec3 n = si.ns;
-    const bool flipped = mat.two_sided && glm::dot(wo_world, n) < 0.f;
-    if (flipped) {  // a two-sided material is seen from whichever side the ray arrives
-        n = -n;
-        si.ng = -si.ng;
-    }
-    sh.frame = Frame(n);
-    sh.wo = sh.frame.to_local(wo_world);
-    if (DiffuseOnly || mat.plain()) {
-        sh.is_wrapped = false;
-        sh.bsdf = mat.textured() ? &bsdf_at(mat, sc.texture_query(si, hit), sh.scratch[0]) : &mat.bsdf;
-        return;
-    }
+// The wrapped part of shade() (frame and wo already set).
+inline void shade_wrapped(const Scene& sc, const Hit& hit, const SurfaceInteraction& si, const Material& mat, bool flipped,
+                          ShadingT<false>& sh) {
     // A wrapped material: the blend tree's leaves, then the perturbed frame.
     const TextureQuery q = sc.texture_query(si, hit);
     WrappedBsdf& wb = sh.wrapped;
@@ -120,6 +103,28 @@ inline void shade(const Scene& sc, const Hit& hit, SurfaceInteraction& si, vec3 
     }
     sh.is_wrapped = true;
 }
+
+// Resolves the material at a hit. `si.ng` is turned with the frame for two-sided materials (the
+// ray offsets use it). `wo_world` points towards the previous vertex.
+template <bool DiffuseOnly>
+inline void shade(const Scene& sc, const Hit& hit, SurfaceInteraction& si, vec3 wo_world, ShadingT<DiffuseOnly>& sh) {
+    const Material& mat = sc.materials[sc.shapes[si.shape].material];
+    vec3 n = si.ns;
+    const bool flipped = mat.two_sided && glm::dot(wo_world, n) < 0.f;
+    if (flipped) {  // a two-sided material is seen from whichever side the ray arrives
+        n = -n;
+        si.ng = -si.ng;
+    }
+    sh.frame = Frame(n);
+    sh.wo = sh.frame.to_local(wo_world);
+    if (DiffuseOnly || mat.plain()) {
+        sh.is_wrapped = false;
+        sh.bsdf = mat.textured() ? &bsdf_at(mat, sc.texture_query(si, hit), sh.scratch[0]) : &mat.bsdf;
+        return;
+    }
+    if constexpr (!DiffuseOnly) shade_wrapped(sc, hit, si, mat, flipped, sh);
+}
+
 
 // Whether any material of the scene is masked: the integrators then test opacity at hits and let
 // shadow rays through masked surfaces; otherwise they never look.

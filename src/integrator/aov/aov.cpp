@@ -64,7 +64,7 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
                 // Mitsuba's blendbsdf returns the blend of its children's values, the other
                 // wrappers their nested BSDF's: the mixture of the leaves, unperturbed.
                 SurfaceInteraction s = si;
-                Shading sh;
+                ShadingT<false> sh;
                 shade<false>(scene, hit, s, -d, sh);
                 vec3 rho(0.f);
                 if (!sh.is_wrapped) rho = diffuse_reflectance(*sh.bsdf, sh.wo);

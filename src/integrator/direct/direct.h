@@ -84,25 +84,25 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     if (!hide && sc.lights.emitter_of(hit) >= 0) L += sc.lights.emitted(si, wo_world);
     if (sc.lights.empty()) return L;
 
-    Shading sh;
+    ShadingT<DiffuseOnly> sh;
     shade<DiffuseOnly>(sc, hit, si, wo_world, sh);
     const Frame& frame = sh.frame;
     const bool masks = !DiffuseOnly && masks_;
 
-    if (sh.template has_smooth_component<DiffuseOnly>()) {
+    if (sh.has_smooth_component()) {
         for (int i = 0; i < n_light_; ++i) {
             float ul = sampler.next_1d();
             vec2 up = sampler.next_2d();
             LightSample ls;
             if (!sc.lights.sample_li(si.p, ul, up, ls) || !(ls.pdf > 0.f)) continue;
             const vec3 wi = frame.to_local(ls.wi);
-            const vec3 f = sh.template eval<DiffuseOnly>(wi);
+            const vec3 f = sh.eval(wi);
             if (is_black(f)) continue;
             Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
             ++stats.rays;
             const float T = shadow_transmittance(sc, shadow, masks, stats.rays);
             if (!(T > 0.f)) continue;
-            const float bsdf_pdf = sh.template pdf<DiffuseOnly>(wi);
+            const float bsdf_pdf = sh.pdf(wi);
             const float w = mis_weight(ls.pdf * frac_light_, bsdf_pdf * frac_bsdf_) * weight_light_;
             L += f * ls.Le * (T * w / ls.pdf);
         }
@@ -116,7 +116,7 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     for (int i = 0; i < n_bsdf_; ++i) {
         float u1 = sampler.next_1d();
         vec2 u2 = sampler.next_2d();
-        std::optional<BsdfSample> bs = sh.template sample<DiffuseOnly>(u1, u2);
+        std::optional<BsdfSample> bs = sh.sample(u1, u2);
         if (!bs || !(bs->pdf > 0.f)) continue;
         vec3 beta = bs->weight();
         if (is_black(beta)) continue;
