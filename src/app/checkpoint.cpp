@@ -283,6 +283,21 @@ uint64_t scene_fingerprint(const Scene& scene) {
     }
     h.u64(scene.emitters.size());
     for (const AreaEmitter& e : scene.emitters) h.v3(e.radiance);
+    // The other lights: probed through their sampling routines, which read every parameter.
+    h.u64(scene.light_params.size());
+    for (const Light& l : scene.light_params) {
+        h.u64(l.model.index());
+        h.v3(light_strength(l.model));
+        for (const vec3& ref : {vec3(0.31f, 0.77f, -0.52f), vec3(-2.f, 3.f, 1.f)}) {
+            LightSample s;
+            const bool ok = sample_li(l.model, scene.lights.scene_sphere(), ref, vec2(0.37f, 0.61f), s);
+            h.u64(ok);
+            if (ok) {
+                h.v3(s.wi);
+                h.v3(s.Le);
+            }
+        }
+    }
 
     // Materials are a closed variant whose members keep changing; probing each one through the
     // BSDF interface covers every parameter that can change an image without naming any of them.

@@ -23,6 +23,26 @@ inline bool skip_area_emitters(const Scene& sc, Ray& ray, Hit& hit, PathStats& s
     return true;
 }
 
+// The shadow ray of a light sample: to the point on the light, or unbounded towards an infinite
+// light.
+inline Ray shadow_ray(const SurfaceInteraction& si, const LightSample& ls) {
+    if (__builtin_expect(ls.infinite, 0)) return spawn_ray(si, ls.wi);
+    return spawn_ray_to(si, ls.p, ls.p_error, ls.n);
+}
+
+// What an escaping ray of direction w brings from the infinite lights, weighted as the emission
+// an area light gives a BSDF-sampled ray: fully after a delta bounce or in BSDF mode, by the power
+// heuristic against that light's sampling density in MIS mode, not at all in light mode (light
+// sampling counted it).
+inline void add_infinite(const LightSet& lights, vec3 w, vec3 beta, bool after_delta, SamplingMode mode, float prev_pdf,
+                         vec3& L) {
+    if (!after_delta && mode == SamplingMode::Light) return;
+    lights.for_each_infinite(w, [&](vec3 Le, float light_pdf) {
+        if (after_delta || mode == SamplingMode::Bsdf) L += beta * Le;
+        else L += beta * Le * power_heuristic(prev_pdf, light_pdf);
+    });
+}
+
 template <class S, bool DiffuseOnly>
 vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const Scene& sc = scene_;
@@ -41,7 +61,15 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     for (int depth = 0;; ++depth) {
         Hit hit;
         ++stats.rays;
-        if (!sc.accel->intersect(ray, hit)) break;  // no environment emitter (yet)
+        if (!sc.accel->intersect(ray, hit)) {
+            // The ray leaves the scene: the infinite lights it sees (hidden from camera rays by
+            // hide_emitters, as Mitsuba). MIS as for area lights, with each light's own pdf.
+            if (sc.lights.has_infinite() && !(depth == 0 && st.integrator.hide_emitters))
+                add_infinite(sc.lights, glm::normalize(ray.d), beta, after_delta, mode, prev_pdf, L);
+            break;
+        }
+        // A camera ray that goes on through hidden area emitters and leaves sees no infinite light
+        // either (it is still at depth 0).
         if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, ray, hit, stats)) break;
         if (depth == 0 && passes == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
@@ -85,11 +113,12 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                 vec3 wi = sh.frame.to_local(ls.wi);
                 vec3 f = sh.eval(wi);
                 if (!is_black(f)) {
-                    Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
+                    Ray shadow = shadow_ray(si, ls);
                     ++stats.rays;
                     const float T = shadow_transmittance(sc, shadow, !DiffuseOnly && masks_, stats.rays);
                     if (T > 0.f) {
-                        float w = mode == SamplingMode::Mis ? power_heuristic(ls.pdf, sh.pdf(wi) * T) : 1.f;
+                        // A delta light cannot be reached by BSDF sampling: no MIS.
+                        float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, sh.pdf(wi) * T) : 1.f;
                         L += beta * f * ls.Le * (T * w / ls.pdf);
                     }
                 }

@@ -139,7 +139,10 @@ inline bool scene_has_masks(const Scene& sc) {
 // Without masks in the scene this is the plain any-hit test.
 inline float shadow_transmittance(const Scene& sc, Ray shadow, bool masks, uint64_t& rays) {
     if (!masks) return sc.accel->occluded(shadow) ? 0.f : 1.f;
-    const vec3 target = shadow.o + shadow.d;  // tmax = 1 - eps stops just short of it
+    // To a point (spawn_ray_to: tmax = 1 - eps stops just short of o + d), or towards an infinite
+    // light (spawn_ray: unbounded).
+    const bool to_point = std::isfinite(shadow.tmax);
+    const vec3 target = shadow.o + shadow.d;
     float T = 1.f;
     for (int i = 0; i < 256; ++i) {
         Hit h;
@@ -150,8 +153,10 @@ inline float shadow_transmittance(const Scene& sc, Ray shadow, bool masks, uint6
         T *= 1.f - m.opacity_at(sc.texture_query(s, h));
         if (!(T > 0.f)) return 0.f;
         shadow.o = offset_ray_origin(s.p, s.p_error, s.ng, shadow.d);
-        shadow.d = target - shadow.o;
-        shadow.tmax = 1.f - kShadowEpsilon;
+        if (to_point) {
+            shadow.d = target - shadow.o;
+            shadow.tmax = 1.f - kShadowEpsilon;
+        }
         ++rays;
     }
     return 0.f;  // a pile of masks deeper than any scene needs: treat as opaque

@@ -4,7 +4,8 @@
 namespace candela {
 
 void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters,
-                     const std::vector<AnalyticShape>* analytic) {
+                     const std::vector<AnalyticShape>* analytic, const std::vector<Light>* lights,
+                     const AABB& bounds) {
     mesh_ = &mesh;
     analytic_ = analytic;
     alights_.clear();
@@ -53,6 +54,23 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
         weights.push_back(w);
     }
     dist_.build(weights);
+
+    lights_.clear();
+    infinite_.clear();
+    if (lights) lights_ = *lights;
+    for (size_t i = 0; i < lights_.size(); ++i)
+        if ((light_flags(lights_[i].model) & (kLightInfinite | kLightDeltaDirection)) == kLightInfinite)
+            infinite_.push_back(uint32_t(i));
+    // Mitsuba's bounding sphere of the scene's box, its radius enlarged by a relative epsilon.
+    if (bounds.empty()) {
+        sphere_ = SceneSphere{vec3(0.f), 1e-4f};
+    } else {
+        sphere_.center = bounds.center();
+        sphere_.radius = std::max(1e-4f, 0.5f * glm::length(bounds.extent()) * (1.f + 1e-4f));
+    }
+    choices_ = uint32_t(lights_.size()) + (has_area() ? 1u : 0u);
+    choice_pmf_ = choices_ > 0 ? 1.f / float(choices_) : 0.f;
+    area_pmf_ = has_area() ? choice_pmf_ : 0.f;
 }
 
 // Exact point and its error bound from barycentrics (pbrt-v4 uses gamma(6) for this sum).
@@ -62,7 +80,27 @@ static inline void interpolate_point(vec3 p0, vec3 p1, vec3 p2, float b0, float 
 }
 
 bool LightSet::sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const {
-    if (empty()) return false;
+    if (__builtin_expect(lights_.empty(), 1)) return has_area() && sample_area_li(ref_p, u1, u2, out);
+    // Uniform choice among (the area lights, light 0, light 1, ...); u1 is reused inside it.
+    const float x = u1 * float(choices_);
+    uint32_t k = std::min(uint32_t(x), choices_ - 1);
+    const float u1r = std::min(x - float(k), 0x1.fffffep-1f);
+    if (has_area()) {
+        if (k == 0) {
+            if (!sample_area_li(ref_p, u1r, u2, out)) return false;
+            out.pdf *= choice_pmf_;
+            return true;
+        }
+        --k;
+    }
+    if (!candela::sample_li(lights_[k].model, sphere_, ref_p, u2, out)) return false;
+    out.pdf *= choice_pmf_;
+    return !is_black(out.Le) && out.pdf > 0.f;
+}
+
+bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const {
+    out.delta = false;
+    out.infinite = false;
     float pmf;
     size_t i = dist_.sample(u1, &pmf);
     if (i >= tris_.size()) {
@@ -116,7 +154,7 @@ float LightSet::pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const {
         if (analytic_light_.empty()) return 0.f;
         int32_t li = analytic_light_[on_light.prim];
         if (li < 0) return 0.f;
-        return dist_.pmf(size_t(li)) * pdf_analytic((*analytic_)[on_light.prim], ref_p, on_light.p, on_light.ng);
+        return area_pmf_ * dist_.pmf(size_t(li)) * pdf_analytic((*analytic_)[on_light.prim], ref_p, on_light.p, on_light.ng);
     }
     if (prim_light_.empty()) return 0.f;
     int32_t li = prim_light_[on_light.prim];
@@ -125,7 +163,7 @@ float LightSet::pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const {
     float dist2 = glm::dot(d, d);
     float cos_light = std::abs(glm::dot(d, on_light.ng)) / std::sqrt(dist2);
     if (!(cos_light > 0.f)) return 0.f;
-    return dist_.pmf(size_t(li)) / area_[size_t(li)] * dist2 / cos_light;
+    return area_pmf_ * dist_.pmf(size_t(li)) / area_[size_t(li)] * dist2 / cos_light;
 }
 
 vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
@@ -138,6 +176,94 @@ vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
     int32_t e = tri_emitter_[on_light.prim];
     if (e < 0 || glm::dot(w, on_light.ns) <= 0.f) return vec3(0.f);
     return emitter_radiance_[size_t(e)];
+}
+
+std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const {
+    if (choices_ == 0) return std::nullopt;
+    const float x = u_sel * float(choices_);
+    uint32_t k = std::min(uint32_t(x), choices_ - 1);
+    const float u1 = std::min(x - float(k), 0x1.fffffep-1f);
+    if (!has_area() || k > 0) {
+        if (has_area()) --k;
+        std::optional<EmissionSample> es = candela::sample_le(lights_[k].model, sphere_, u_pos, u_dir);
+        if (es) es->pdf_pos *= choice_pmf_;
+        return es;
+    }
+    float pmf;
+    size_t i = dist_.sample(u1, &pmf);
+    EmissionSample es;
+    es.flags = kLightArea;
+    vec3 p, err, ng, ns;
+    float area;
+    if (i >= tris_.size()) {
+        const AnalyticShape& a = (*analytic_)[alights_[i - tris_.size()]];
+        // Seen from inside a sphere, and from anywhere for a disk or cylinder, sample_analytic draws
+        // uniformly by area (only its point is used here): from the centre, from a point on the
+        // disk's axis, from the middle of the cylinder's axis.
+        vec3 ref = a.center;
+        if (a.kind == PrimKind::Disk) ref = vec3(a.to_world[3]) + a.normal * std::sqrt(a.area);
+        if (a.kind == PrimKind::Cylinder) ref = vec3(a.to_world * glm::vec4(0.f, 0.f, 0.5f * a.length, 1.f));
+        AnalyticSample as;
+        if (!sample_analytic(a, ref, u_pos, as)) return std::nullopt;
+        p = as.p;
+        err = as.p_error;
+        ng = ns = as.n;
+        area = a.area;
+        es.Le = emitter_radiance_[size_t(analytic_emitter_[alights_[i - tris_.size()]])];
+    } else {
+        uint32_t tri = tris_[i];
+        vec3 p0, p1, p2;
+        mesh_->vertices(tri, p0, p1, p2);
+        vec2 b = square_to_uniform_triangle(u_pos);
+        interpolate_point(p0, p1, p2, b.x, b.y, 1.f - b.x - b.y, p, err);
+        ng = glm::cross(p1 - p0, p2 - p0);
+        float len = glm::length(ng);
+        if (!(len > 0.f)) return std::nullopt;
+        ng /= len;
+        ns = ng;
+        if (!mesh_->normals.empty()) {
+            const uvec3& t = mesh_->triangles[tri];
+            vec3 n = b.x * mesh_->normals[t.x] + b.y * mesh_->normals[t.y] + (1.f - b.x - b.y) * mesh_->normals[t.z];
+            if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
+        }
+        area = area_[i];
+        es.Le = radiance_[i];
+    }
+    // Cosine-distributed about the emitting side (the shading normal's, as emitted()).
+    vec3 local = square_to_cosine_hemisphere(u_dir);
+    Frame f(ns);
+    vec3 d = f.to_world(local);
+    if (!(local.z > 0.f)) return std::nullopt;
+    SurfaceInteraction si;
+    si.p = p;
+    si.p_error = err;
+    si.ng = ng;
+    es.ray = spawn_ray(si, d);
+    es.n = ns;
+    es.pdf_pos = area_pmf_ * pmf / area;
+    es.pdf_dir = square_to_cosine_hemisphere_pdf(local);
+    return es;
+}
+
+void LightSet::pdf_le(const SurfaceInteraction& on_light, vec3 w, float& pdf_pos, float& pdf_dir) const {
+    pdf_pos = pdf_dir = 0.f;
+    int32_t li = -1;
+    float area = 0.f;
+    if (on_light.kind != PrimKind::Triangle) {
+        if (!analytic_light_.empty()) li = analytic_light_[on_light.prim];
+        if (li >= 0) area = (*analytic_)[on_light.prim].area;
+    } else if (!prim_light_.empty()) {
+        li = prim_light_[on_light.prim];
+        if (li >= 0) area = area_[size_t(li)];
+    }
+    if (li < 0) return;
+    pdf_pos = area_pmf_ * dist_.pmf(size_t(li)) / area;
+    pdf_dir = std::max(glm::dot(w, on_light.ns), 0.f) * kInvPi;
+}
+
+void LightSet::pdf_le(size_t i, vec3 d, float& pdf_pos, float& pdf_dir) const {
+    candela::pdf_le(lights_[i].model, sphere_, d, pdf_pos, pdf_dir);
+    pdf_pos *= choice_pmf_;
 }
 
 }  // namespace candela

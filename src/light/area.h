@@ -3,6 +3,7 @@
 #include "geometry/analytic.h"
 #include "geometry/interaction.h"
 #include "geometry/mesh.h"
+#include "light/emitter.h"
 #include "sampling/distribution.h"
 
 namespace candela {
@@ -13,35 +14,61 @@ struct AreaEmitter {
     vec3 radiance{0.f};
 };
 
-// A point chosen on a light for next-event estimation, seen from a reference point.
-struct LightSample {
-    vec3 p{0.f}, p_error{0.f};  // point on the light and its error bound
-    vec3 n{0.f};                // geometric normal at p
-    vec3 wi{0.f};               // unit direction from the reference point to p
-    float dist = 0.f;           // distance from the reference point to p
-    vec3 Le{0.f};               // radiance leaving p towards the reference point
-    float pdf = 0.f;            // solid-angle density at the reference point (includes the pmf)
-};
-
-// All emissive triangles and analytic shapes of the scene. A triangle or shape is picked with
-// probability proportional to area x luminance(radiance). On a triangle the point is uniform by area
-// and the density converted to solid angle at the reference point: pdf_sa = pmf(tri) / area(tri)
-// * dist^2 / |cos theta_light|. On an analytic shape it is sample_analytic's (a sphere seen from
-// outside: uniform in the cone it subtends), times the pmf.
+// Every light of the scene: the emissive triangles and analytic shapes, and the emitters that are
+// not on a shape (light/emitter.h).
+//
+// Selection (u1): the choices are "the area lights" (one choice, when there are any) and each
+// other light, picked uniformly (as pbrt-v4's UniformLightSampler, and as Mitsuba, which picks its
+// emitters uniformly): pmf 1 / n_choices. Within the area lights a triangle or shape is picked with
+// probability proportional to area x luminance(radiance). A scene with area lights only has one
+// choice, pmf 1, and samples exactly as before the other emitters existed. Unbiased whatever the
+// mix: every light with a nonzero contribution has a nonzero pmf.
+//
+// On a triangle the point is uniform by area and the density converted to solid angle at the
+// reference point: pdf_sa = pmf(tri) / area(tri) * dist^2 / |cos theta_light|. On an analytic shape
+// it is sample_analytic's (a sphere seen from outside: uniform in the cone it subtends), times the
+// pmf. The other lights: light/emitter.h, times their pmf.
 class LightSet {
 public:
+    // `lights` and `bounds` (the scene's geometry, for the infinite lights' bounding sphere) may be
+    // left out by a scene of area lights.
     void build(const Mesh& mesh, const std::vector<Shape>& shapes, const std::vector<AreaEmitter>& emitters,
-               const std::vector<AnalyticShape>* analytic = nullptr);
+               const std::vector<AnalyticShape>* analytic = nullptr, const std::vector<Light>* lights = nullptr,
+               const AABB& bounds = AABB());
 
-    bool empty() const { return tris_.empty() && alights_.empty(); }
+    bool empty() const { return tris_.empty() && alights_.empty() && lights_.empty(); }
     size_t triangle_count() const { return tris_.size(); }
+    size_t light_count() const { return lights_.size(); }  // the lights not on shapes
+    const Light& light(size_t i) const { return lights_[i]; }
+    const SceneSphere& scene_sphere() const { return sphere_; }
 
-    // u1 picks the triangle, u2 the point on it. Returns false where nothing can be emitted
-    // towards ref_p (back side of a one-sided light, zero radiance, or a degenerate geometry).
+    // u1 picks the light (and the triangle), u2 the point on it. Returns false where nothing can be
+    // emitted towards ref_p (back side of a one-sided light, outside a spot's cone, zero radiance,
+    // or a degenerate geometry).
     bool sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const;
 
     // Solid-angle density with which sample_li would pick the point `on_light` from ref_p.
     float pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const;
+
+    // The infinite lights that a ray can see (constant, environment; not directional, a delta):
+    // f(Le, pdf) for each, Le the radiance arriving along -w (w the escaping ray's direction) and
+    // pdf the solid-angle density with which sample_li picks w through that light (with its pmf).
+    bool has_infinite() const { return !infinite_.empty(); }
+    template <class F>
+    void for_each_infinite(vec3 w, F&& f) const {
+        for (uint32_t i : infinite_)
+            f(candela::eval_infinite(lights_[i].model, w), choice_pmf_ * candela::pdf_li(lights_[i].model, w));
+    }
+
+    // Emission sampling over all lights (light/emitter.h, "sample_le"): u_sel picks the light as
+    // sample_li does, and pdf_pos includes that pmf. Area lights: a point uniform by area on the
+    // chosen triangle or shape, a cosine-distributed direction on its emitting side. Returns
+    // nothing when the scene has no light or the chosen one emits nothing there.
+    std::optional<EmissionSample> sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const;
+    // The densities sample_le gives to a ray leaving `on_light` (an area light's point) in w.
+    void pdf_le(const SurfaceInteraction& on_light, vec3 w, float& pdf_pos, float& pdf_dir) const;
+    // The densities sample_le gives to a ray of direction d from light i of light(i).
+    void pdf_le(size_t i, vec3 d, float& pdf_pos, float& pdf_dir) const;
 
     // Radiance leaving a point of an emissive shape in direction w (world space, unit).
     vec3 emitted(const SurfaceInteraction& on_light, vec3 w) const;
@@ -63,7 +90,8 @@ public:
                radiance_.capacity() * sizeof(vec3) + prim_light_.capacity() * sizeof(int32_t) +
                tri_emitter_.capacity() * sizeof(int32_t) + emitter_radiance_.capacity() * sizeof(vec3) +
                alights_.capacity() * sizeof(uint32_t) + analytic_light_.capacity() * sizeof(int32_t) +
-               analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes();
+               analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes() +
+               lights_.capacity() * sizeof(Light) + infinite_.capacity() * sizeof(uint32_t);
     }
 
 private:
@@ -80,6 +108,16 @@ private:
     std::vector<int32_t> analytic_light_;     // analytic index -> dist_ entry, or -1
     std::vector<int32_t> analytic_emitter_;   // analytic index -> emitter index, or -1
     DiscreteDistribution dist_;
+    // The other lights and the selection among "the area lights" and them.
+    std::vector<Light> lights_;
+    std::vector<uint32_t> infinite_;  // indices into lights_ that a ray can see
+    SceneSphere sphere_;
+    uint32_t choices_ = 0;      // (area lights ? 1 : 0) + lights_.size()
+    float choice_pmf_ = 1.f;    // 1 / choices_
+    float area_pmf_ = 1.f;      // choice_pmf_ when there are area lights
+
+    bool has_area() const { return !tris_.empty() || !alights_.empty(); }
+    bool sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const;
 };
 
 }  // namespace candela

@@ -38,6 +38,18 @@ inline vec3 square_to_uniform_sphere(vec2 u) {
 }
 inline float square_to_uniform_sphere_pdf(vec3) { return kInv4Pi; }
 
+// Uniform direction in the cone of half-angle acos(cos_max) about +z; pdf = 1 / (2 pi (1 - cos_max))
+// per steradian inside the cone, 0 outside.
+inline vec3 square_to_uniform_cone(vec2 u, float cos_max) {
+    float z = 1.f - u.x * (1.f - cos_max);
+    float r = safe_sqrt(1.f - z * z);
+    float phi = 2.f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+inline float square_to_uniform_cone_pdf(vec3 v, float cos_max) {
+    return v.z >= cos_max && cos_max < 1.f ? kInv2Pi / (1.f - cos_max) : 0.f;
+}
+
 inline vec3 square_to_uniform_hemisphere(vec2 u) {
     float z = u.x;
     float r = safe_sqrt(1.f - z * z);

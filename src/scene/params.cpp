@@ -160,6 +160,19 @@ vec3 ParamSet::get_point(const std::string& name, vec3 def) const {
     return vec3(v[0], v[1], v[2]);
 }
 
+vec3 ParamSet::get_vector(const std::string& name, vec3 def) const {
+    const Param* p = fetch(name, ParamType::Vector, ParamType::Vector);
+    if (!p) return def;
+    std::vector<float> v;
+    try {
+        v = parse_float_list(p->value);
+    } catch (const std::invalid_argument&) {
+        v.clear();
+    }
+    if (v.size() != 3) throw Error(file_, p->line, "could not parse vector '" + p->value + "' for parameter '" + name + "'");
+    return vec3(v[0], v[1], v[2]);
+}
+
 mat4 ParamSet::get_transform(const std::string& name, const mat4& def) const {
     const Param* p = fetch(name, ParamType::Transform, ParamType::Transform);
     return p ? p->transform : def;

@@ -45,6 +45,7 @@ public:
     std::string get_string(const std::string& name, const std::string& def) const;
     vec3 get_rgb(const std::string& name, vec3 def) const;
     vec3 get_point(const std::string& name, vec3 def) const;  // a <point> (3 numbers)
+    vec3 get_vector(const std::string& name, vec3 def) const;  // a <vector> (3 numbers)
     mat4 get_transform(const std::string& name, const mat4& def) const;
 
     // The line of a parameter (0 when absent), for messages about its value.

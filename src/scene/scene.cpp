@@ -73,6 +73,12 @@ void check_params(const std::string& source, const std::vector<Shape>& shapes, c
             throw Error(source, 0, "shape '" + s.name + "' names emitter " + std::to_string(s.emitter) + " of " +
                                        std::to_string(p.emitters.size()));
     }
+    for (const Light& l : p.lights) {
+        const vec3 v = light_strength(l.model);
+        if (!all_finite(v) || !(min_component(v) >= 0.f))
+            throw Error(source, 0, "emitter '" + l.name + "': " + light_strength_name(l.model) +
+                                       " must be finite and not negative");
+    }
 }
 
 // A shape's uvs and colours are found from its vertex indices: they must stay in its run. Checks
@@ -112,6 +118,13 @@ bool same_emitters(const std::vector<AreaEmitter>& a, const std::vector<AreaEmit
     return true;
 }
 
+bool same_lights(const std::vector<Light>& a, const std::vector<Light>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (!same_light(a[i], b[i])) return false;
+    return true;
+}
+
 }  // namespace
 
 Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std::shared_ptr<const Accel> accel_,
@@ -130,6 +143,7 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       settings(p.settings),
       materials(prepared(p.materials)),
       emitters(p.emitters),
+      light_params(p.lights),
       warnings(std::move(warnings_)) {}
 
 std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::string& accel_name) {
@@ -166,7 +180,8 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
         if (in.group >= desc.groups.size()) throw Error(desc.source, 0, "instance of an unknown shapegroup");
         in.bounds = transform_box(in.to_world, desc.groups[in.group].bounds());
     }
-    SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters)};
+    SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters),
+                       std::move(desc.lights)};
     check_params(desc.source, desc.shapes, params);
 
     auto geometry = std::make_shared<Geometry>();
@@ -190,7 +205,8 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     }
     std::shared_ptr<const Accel> accel(std::move(tri_accel));
     auto lights = std::make_shared<LightSet>();
-    lights->build(geometry->mesh, geometry->shapes, params.emitters, &geometry->analytic);
+    lights->build(geometry->mesh, geometry->shapes, params.emitters, &geometry->analytic, &params.lights,
+                  geometry->bounds);
     return std::shared_ptr<const Scene>(
         new Scene(std::move(desc.source), std::move(geometry), std::move(accel), std::move(lights), params,
                   std::move(desc.warnings)));
@@ -199,9 +215,9 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
 std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     check_params(source, shapes, p);
     std::shared_ptr<const LightSet> lights_for = light_set;
-    if (!same_emitters(emitters, p.emitters)) {
+    if (!same_emitters(emitters, p.emitters) || !same_lights(light_params, p.lights)) {
         auto rebuilt = std::make_shared<LightSet>();
-        rebuilt->build(mesh, shapes, p.emitters, &analytic);
+        rebuilt->build(mesh, shapes, p.emitters, &analytic, &p.lights, geometry->bounds);
         lights_for = std::move(rebuilt);
     }
     return std::shared_ptr<const Scene>(new Scene(source, geometry, accel, std::move(lights_for), p, warnings));

@@ -48,6 +48,7 @@ struct SceneParams {
     RenderSettings settings;
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
+    std::vector<Light> lights;  // the emitters not on shapes (point, spot, directional, constant)
 };
 
 // A scene as loaded, before anything is derived from it. Loaders fill it; build_scene consumes it.
@@ -60,6 +61,7 @@ struct SceneDescription {
     std::vector<Instance> instances;      // instances (Instance::group indexes groups)
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
+    std::vector<Light> lights;            // top-level emitters (light/emitter.h)
     Camera camera;
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
@@ -104,6 +106,7 @@ public:
     const RenderSettings settings;
     const std::vector<Material> materials;
     const std::vector<AreaEmitter> emitters;
+    const std::vector<Light> light_params;  // SceneParams::lights (the light set holds its copy)
     const std::vector<std::string> warnings;
 
     Scene(const Scene&) = delete;
@@ -115,7 +118,7 @@ public:
     // time, the render worker, not the window. Throws Error when `p` does not fit the geometry
     // (another number of materials or emitters, an impossible film size).
     std::shared_ptr<const Scene> with_params(const SceneParams& p) const;
-    SceneParams params() const { return {camera, settings, materials, emitters}; }
+    SceneParams params() const { return {camera, settings, materials, emitters, light_params}; }
 
     // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
     // of the point. In an instance (hit.instance set) the group-space interaction is taken to

@@ -112,4 +112,6 @@ bool edit_material(Material& m) {
 
 bool edit_emitter(AreaEmitter& e) { return drag_positive("radiance", e.radiance, 0.05f); }
 
+bool edit_light(Light& l) { return drag_positive(light_strength_name(l.model), light_strength(l.model), 0.05f); }
+
 }  // namespace candela

@@ -19,5 +19,6 @@ bool edit_material(Material& m);
 
 // Radiance of an area light (RGB, may exceed 1).
 bool edit_emitter(AreaEmitter& e);
+bool edit_light(Light& l);  // a top-level emitter's intensity, irradiance or radiance
 
 }  // namespace candela

@@ -147,7 +147,8 @@ void Viewer::panel() {
         }
     }
 
-    if (!fe_->params().emitters.empty() && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
+    const bool any_light = !fe_->params().emitters.empty() || !fe_->params().lights.empty();
+    if (any_light && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
         for (size_t i = 0; i < fe_->params().emitters.size(); ++i) {
             ImGui::PushID(int(i) + 100000);
             std::string label = "light " + std::to_string(i);
@@ -158,6 +159,14 @@ void Viewer::panel() {
                 }
             ImGui::TextUnformatted(label.c_str());
             if (edit_emitter(fe_->params().emitters[i])) fe_->params_changed(viewer_now());
+            ImGui::PopID();
+        }
+        // The emitters not on shapes: an edit goes through with_params, which rebuilds the light set only.
+        for (size_t i = 0; i < fe_->params().lights.size(); ++i) {
+            ImGui::PushID(int(i) + 200000);
+            Light& l = fe_->params().lights[i];
+            ImGui::Text("%s (%s)", l.name.c_str(), light_type_name(l.model));
+            if (edit_light(l)) fe_->params_changed(viewer_now());
             ImGui::PopID();
         }
     }
@@ -185,6 +194,9 @@ void Viewer::panel_pick() {
     }
     if (!pick.hit) {
         ImGui::TextDisabled("nothing there (background)");
+        for (const Light& l : fe_->params().lights)
+            if ((light_flags(l.model) & (kLightInfinite | kLightDeltaDirection)) == kLightInfinite)
+                ImGui::Text("background light  %s (%s)", l.name.c_str(), light_type_name(l.model));
         return;
     }
     const Shape& shape = fe_->scene().shapes[pick.shape];

@@ -8,7 +8,10 @@
 // and n_l, n_b the two counts, so that the weights of one direction sum to one over the n_l + n_b
 // samples (Veach's balance of sample counts). Delta lobes: a BSDF-sampled delta direction has no
 // light-sampling density (w_b = 1); light samples are taken only when the BSDF has a smooth part.
-// hide_emitters: the camera ray passes through area emitters (as in the path tracer).
+// hide_emitters: the camera ray passes through area emitters (as in the path tracer) and does not
+// see the infinite lights. Delta lights (point, spot, directional) are reached by light samples
+// only, with w_l = 1 (Mitsuba's: not 1 / n_l, so they count n_l times); BSDF samples that leave the scene see the infinite lights, weighted as
+// above with each light's own density.
 // Sample order per pixel sample: for each light sample next_1d (which emitter triangle), next_2d
 // (the point); then for each BSDF sample next_1d, next_2d.
 #include "integrator/integrator.h"
@@ -61,8 +64,12 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const Scene& sc = scene_;
     Hit hit;
     ++stats.rays;
-    if (!sc.accel->intersect(ray, hit)) return vec3(0.f);
     const bool hide = sc.settings.integrator.hide_emitters;
+    if (!sc.accel->intersect(ray, hit)) {
+        vec3 Le(0.f);  // the infinite lights seen directly, unless hidden (Mitsuba's semantics)
+        if (!hide) sc.lights.for_each_infinite(glm::normalize(ray.d), [&](vec3 e, float) { Le += e; });
+        return Le;
+    }
     if (hide && !skip_area_emitters(sc, ray, hit, stats)) return vec3(0.f);
     SurfaceInteraction si = sc.interaction(hit);
     if constexpr (!DiffuseOnly) {
@@ -98,12 +105,15 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             const vec3 wi = frame.to_local(ls.wi);
             const vec3 f = sh.eval(wi);
             if (is_black(f)) continue;
-            Ray shadow = spawn_ray_to(si, ls.p, ls.p_error, ls.n);
+            Ray shadow = shadow_ray(si, ls);
             ++stats.rays;
             const float T = shadow_transmittance(sc, shadow, masks, stats.rays);
             if (!(T > 0.f)) continue;
-            const float bsdf_pdf = sh.pdf(wi);
-            const float w = mis_weight(ls.pdf * frac_light_, bsdf_pdf * frac_bsdf_) * weight_light_;
+            // A delta light: weight 1, exactly as Mitsuba 3.9's direct.cpp (`select(ds.delta, 1,
+            // mis_weight(...) * m_weight_lum)`): it is NOT divided by emitter_samples, so with n_l
+            // light samples a delta light counts n_l times. Kept for agreement with Mitsuba
+            // (docs/lights.md); the smooth lights get 1 / n_l.
+            const float w = ls.delta ? 1.f : mis_weight(ls.pdf * frac_light_, sh.pdf(wi) * frac_bsdf_) * weight_light_;
             L += f * ls.Le * (T * w / ls.pdf);
         }
     } else {
@@ -131,12 +141,22 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             const Material& m = sc.materials[sc.shapes[sm.shape].material];
             if (!m.masked || sc.lights.emitter_of(h) >= 0) break;
             beta *= 1.f - m.opacity_at(sc.texture_query(sm, h));
+            if (is_black(beta)) break;
             r = spawn_ray(sm, r.d);
             h = Hit();
             ++stats.rays;
-            found = !is_black(beta) && sc.accel->intersect(r, h);
+            found = sc.accel->intersect(r, h);
         }
-        if (!found || sc.lights.emitter_of(h) < 0) continue;
+        if (is_black(beta)) continue;
+        if (!found) {
+            // Escaped: the infinite lights, each weighted against its own sampling density.
+            sc.lights.for_each_infinite(glm::normalize(r.d), [&](vec3 Le, float light_pdf) {
+                if (bs->delta) light_pdf = 0.f;
+                L += beta * Le * (mis_weight(bs->pdf * frac_bsdf_, light_pdf * frac_light_) * weight_bsdf_);
+            });
+            continue;
+        }
+        if (sc.lights.emitter_of(h) < 0) continue;
         const SurfaceInteraction se = sc.interaction(h);
         const vec3 Le = sc.lights.emitted(se, -glm::normalize(r.d));
         if (is_black(Le)) continue;

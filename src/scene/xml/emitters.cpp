@@ -1,5 +1,6 @@
-// The emitter family of the XML reader: area emitters nested in shapes. Emitters elsewhere (point,
-// spot, directional, constant, envmap) are issue 13 part 2 and stay errors.
+// The emitter family of the XML reader, one table for every emitter plugin: `area` (nested in a
+// shape, or referenced by one) and the top-level `point`, `spot`, `directional` and `constant`
+// (light/emitter.h). `envmap` is refused until the environment map class is wired in.
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -7,30 +8,105 @@ namespace xml {
 
 namespace {
 
-AreaEmitter make_area(XmlLoader&, Object& e) {
-    vec3 radiance = e.params.get_rgb("radiance", vec3(1.f));
-    if (!(min_component(radiance) >= 0.f)) throw e.params.error("radiance", "radiance must not be negative");
-    return AreaEmitter{radiance};
+vec3 strength(Object& e, const char* name) {
+    vec3 v = e.params.get_rgb(name, vec3(1.f));
+    if (!all_finite(v) || !(min_component(v) >= 0.f))
+        throw e.params.error(name, std::string(name) + " must be finite and not negative");
+    return v;
+}
+
+// A direction-valued to_world: its +z, normalised.
+vec3 transformed_z(Object& e, const mat4& m) {
+    vec3 d = glm::mat3(m) * vec3(0.f, 0.f, 1.f);
+    float len = glm::length(d);
+    if (!(len > 0.f) || !std::isfinite(len)) throw e.params.error("to_world", "to_world maps +z to a zero direction");
+    return d / len;
+}
+
+EmitterModel make_area(XmlLoader&, Object& e) {
+    return AreaEmitter{strength(e, "radiance")};
+}
+
+EmitterModel make_point(XmlLoader& L, Object& e) {
+    PointLight l;
+    l.intensity = strength(e, "intensity");
+    if (e.params.has("position") && e.params.has("to_world"))
+        throw L.error(e.node, "point: only one of 'position' and 'to_world' may be given");
+    l.position = e.params.get_point("position", vec3(0.f));
+    if (e.params.has("to_world")) l.position = vec3(e.params.get_transform("to_world", mat4(1.f))[3]);
+    if (!all_finite(l.position)) throw L.error(e.node, "point: the position is not finite");
+    return l;
+}
+
+EmitterModel make_spot(XmlLoader& L, Object& e) {
+    SpotLight l;
+    l.intensity = strength(e, "intensity");
+    l.to_world = e.params.get_transform("to_world", mat4(1.f));
+    l.cutoff_angle = e.params.get_float("cutoff_angle", 20.f);
+    if (!(l.cutoff_angle > 0.f && l.cutoff_angle <= 90.f))
+        throw e.params.error("cutoff_angle", "cutoff_angle must be in (0, 90] degrees");
+    l.beam_width = e.params.get_float("beam_width", l.cutoff_angle * 3.f / 4.f);
+    if (!(l.beam_width >= 0.f && l.beam_width <= l.cutoff_angle))
+        throw e.params.error("beam_width", "beam_width must be in [0, cutoff_angle] degrees");
+    if (glm::determinant(glm::mat3(l.to_world)) == 0.f || !std::isfinite(glm::determinant(glm::mat3(l.to_world))))
+        throw e.params.error("to_world", "spot: to_world is singular");
+    l.texture = nested_texture(L, e, "texture");
+    if (l.texture && l.texture->is_constant())
+        throw L.error(e.node, "spot: 'texture' must vary over the cone (e.g. a bitmap), as in Mitsuba");
+    return l;
+}
+
+EmitterModel make_directional(XmlLoader& L, Object& e) {
+    DirectionalLight l;
+    l.irradiance = strength(e, "irradiance");
+    if (e.params.has("direction") && e.params.has("to_world"))
+        throw L.error(e.node, "directional: only one of 'direction' and 'to_world' may be given");
+    if (e.params.has("direction")) {
+        vec3 d = e.params.get_vector("direction", vec3(0.f, 0.f, 1.f));
+        float len = glm::length(d);
+        if (!(len > 0.f) || !std::isfinite(len)) throw e.params.error("direction", "direction must not be zero");
+        l.direction = d / len;
+    } else if (e.params.has("to_world")) {
+        l.direction = transformed_z(e, e.params.get_transform("to_world", mat4(1.f)));
+    }
+    return l;
+}
+
+EmitterModel make_constant(XmlLoader&, Object& e) {
+    return ConstantLight{strength(e, "radiance")};
+}
+
+EmitterModel refuse_envmap(XmlLoader& L, Object& e) {
+    throw L.error(e.node, "emitter 'envmap' is not supported yet (the environment map is not wired in)");
 }
 
 }  // namespace
 
-const PluginTable<AreaEmitterFactory>& area_emitter_plugins() {
-    static const PluginTable<AreaEmitterFactory> table = {
-        {"area", make_area},
+const PluginTable<EmitterFactory>& emitter_plugins() {
+    static const PluginTable<EmitterFactory> table = {
+        {"area", make_area},           {"point", make_point},       {"spot", make_spot},
+        {"directional", make_directional}, {"constant", make_constant}, {"envmap", refuse_envmap},
     };
     return table;
 }
 
+namespace {
+EmitterFactory find_emitter(XmlLoader& L, const Object& e) {
+    for (const auto& p : emitter_plugins())
+        if (e.type == p.type) return p.make;
+    std::string known;
+    for (const auto& p : emitter_plugins())
+        if (std::string(p.type) != "envmap") known += (known.empty() ? "" : ", ") + std::string(p.type);
+    throw L.error(e.node, "unsupported emitter type '" + e.type + "' (candela supports: " + known + ")");
+}
+}  // namespace
+
 int32_t load_shape_emitter(XmlLoader& L, pugi::xml_node n) {
     Object e = L.read_object(n, "emitter");
-    AreaEmitterFactory make = nullptr;
-    for (const auto& p : area_emitter_plugins())
-        if (e.type == p.type) make = p.make;
-    if (!make) throw L.error(n, "unsupported emitter type '" + e.type + "' inside a shape (area)");
-    AreaEmitter a = make(L, e);
+    if (e.type != "area") throw L.error(n, "unsupported emitter type '" + e.type + "' inside a shape (area)");
+    EmitterModel m = find_emitter(L, e)(L, e);
     L.finish(e);
-    L.scene().emitters.push_back(a);
+    L.scene().emitters.push_back(std::get<AreaEmitter>(m));
     return int32_t(L.scene().emitters.size() - 1);
 }
 
@@ -38,7 +114,17 @@ void load_emitter(XmlLoader& L, pugi::xml_node n) {
     if (L.attr(n, "type") == "area" && n.attribute("id")) return;  // built by the shapes that <ref> it
     Object e = L.read_object(n, "emitter");
     if (e.type == "area") throw L.error(n, "an area emitter must be nested inside a <shape> or referenced by one");
-    throw L.error(n, "unsupported emitter type '" + e.type + "' (candela supports area emitters on shapes)");
+    EmitterModel m = find_emitter(L, e)(L, e);
+    L.finish(e);
+    Light l;
+    l.model = std::visit([](auto&& v) -> LightModel {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, AreaEmitter>) return ConstantLight{};  // not reached
+        else return v;
+    }, m);
+    std::vector<Light>& lights = L.scene().lights;
+    l.name = n.attribute("id") ? std::string(n.attribute("id").value())
+                               : std::string(light_type_name(l.model)) + " " + std::to_string(lights.size());
+    lights.push_back(std::move(l));
 }
 
 }  // namespace xml

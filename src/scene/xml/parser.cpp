@@ -606,9 +606,17 @@ mat4 XmlLoader::read_transform(pugi::xml_node n) const {
             vec3 axis = xyz(0.f);
             float angle = c.attribute("angle") ? numbers(c, "angle", {1})[0] : 0.f;
             if (!(glm::length(axis) > 0.f)) throw error(c, "<rotate> needs a non-zero axis (x, y, z or value)");
-            // Normalised: Mitsuba 3.9 rotates about the axis as given, which for a non-unit axis
-            // is not a rotation (it also scales); docs/scene-format.md lists the difference.
-            t = glm::rotate(mat4(1.f), glm::radians(angle), glm::normalize(axis));
+            // Mitsuba 3.9's matrix, c I + s [a]x + (1 - c) a a^T, with the axis a as given: for a
+            // non-unit axis that is not a rotation (it also scales and shears), but published
+            // scenes (mdata_hello_teapot) rely on it, so candela builds the same matrix.
+            const float rad = glm::radians(angle), s = std::sin(rad), co = std::cos(rad);
+            const vec3 a = axis;
+            t = mat4(1.f);
+            for (int r = 0; r < 3; ++r)
+                for (int col = 0; col < 3; ++col) t[col][r] = (1.f - co) * a[r] * a[col] + (r == col ? co : 0.f);
+            t[1][0] -= s * a.z, t[2][0] += s * a.y;  // the cross-product matrix [a]x, times sin
+            t[0][1] += s * a.z, t[2][1] -= s * a.x;
+            t[0][2] -= s * a.y, t[1][2] += s * a.x;
         } else if (op == "matrix") {
             check_attributes(c, {"value"});
             std::vector<float> v = numbers(c, "value", {16, 9});

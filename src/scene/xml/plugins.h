@@ -37,11 +37,12 @@ void load_shapegroup(XmlLoader& L, Object& o);
 void load_instance(XmlLoader& L, Object& o);
 
 // ---- emitters.cpp: <emitter> nested in a shape (area), and top-level emitters ----
-using AreaEmitterFactory = AreaEmitter (*)(XmlLoader&, Object&);
-const PluginTable<AreaEmitterFactory>& area_emitter_plugins();
+using EmitterModel = std::variant<AreaEmitter, PointLight, SpotLight, DirectionalLight, ConstantLight>;
+using EmitterFactory = EmitterModel (*)(XmlLoader&, Object&);
+const PluginTable<EmitterFactory>& emitter_plugins();
 // The emitter nested in a shape: its index in scene().emitters.
 int32_t load_shape_emitter(XmlLoader& L, pugi::xml_node n);
-void load_emitter(XmlLoader& L, pugi::xml_node n);  // top level
+void load_emitter(XmlLoader& L, pugi::xml_node n);  // top level: appends to scene().lights
 
 // ---- sensors.cpp: <sensor> with its <film> (and <rfilter>) and <sampler> ----
 using SensorFactory = Camera (*)(XmlLoader&, Object&);

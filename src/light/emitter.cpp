@@ -1,0 +1,228 @@
+#include "light/emitter.h"
+#include "sampling/warp.h"
+
+namespace candela {
+
+namespace {
+
+template <class... F>
+struct overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+overloaded(F...) -> overloaded<F...>;
+
+float radians(float deg) { return deg * (kPi / 180.f); }
+
+// A point on the disk of the scene's bounding sphere that faces direction w, through its centre
+// (pbrt-v4's infinite-light emission: every ray that reaches the scene crosses that disk).
+vec3 disk_point(const SceneSphere& s, vec3 w, vec2 u) {
+    vec2 d = square_to_uniform_disk_concentric(u);
+    Frame f(w);
+    return s.center + s.radius * (f.s * d.x + f.t * d.y);
+}
+
+}  // namespace
+
+vec3 SpotLight::profile(vec3 d) const {
+    const float cutoff = radians(cutoff_angle), beam = radians(beam_width);
+    const float cos_theta = d.z;
+    if (!(cos_theta > std::cos(cutoff))) return vec3(0.f);
+    // Linear in angle from 1 at beam_width to 0 at cutoff_angle (Mitsuba's falloff_curve).
+    float falloff = cos_theta >= std::cos(beam) ? 1.f : (cutoff - std::acos(std::min(cos_theta, 1.f))) / (cutoff - beam);
+    falloff = glm::clamp(falloff, 0.f, 1.f);
+    vec3 v(falloff);
+    if (texture) {
+        const float uv_factor = std::tan(cutoff);
+        TextureQuery q;
+        q.uv = vec2(0.5f + 0.5f * d.x / (d.z * uv_factor), 0.5f + 0.5f * d.y / (d.z * uv_factor));
+        v *= texture->eval(q);
+    }
+    return v;
+}
+
+uint32_t light_flags(const LightModel& m) {
+    return std::visit(overloaded{[](const PointLight&) { return uint32_t(kLightDeltaPosition); },
+                                 [](const SpotLight&) { return uint32_t(kLightDeltaPosition); },
+                                 [](const DirectionalLight&) { return uint32_t(kLightDeltaDirection | kLightInfinite); },
+                                 [](const ConstantLight&) { return uint32_t(kLightInfinite); }},
+                      m);
+}
+
+const char* light_type_name(const LightModel& m) {
+    return std::visit(overloaded{[](const PointLight&) { return "point"; }, [](const SpotLight&) { return "spot"; },
+                                 [](const DirectionalLight&) { return "directional"; },
+                                 [](const ConstantLight&) { return "constant"; }},
+                      m);
+}
+
+vec3& light_strength(LightModel& m) {
+    return std::visit(overloaded{[](PointLight& l) -> vec3& { return l.intensity; },
+                                 [](SpotLight& l) -> vec3& { return l.intensity; },
+                                 [](DirectionalLight& l) -> vec3& { return l.irradiance; },
+                                 [](ConstantLight& l) -> vec3& { return l.radiance; }},
+                      m);
+}
+vec3 light_strength(const LightModel& m) { return light_strength(const_cast<LightModel&>(m)); }
+
+const char* light_strength_name(const LightModel& m) {
+    return std::visit(overloaded{[](const PointLight&) { return "intensity"; }, [](const SpotLight&) { return "intensity"; },
+                                 [](const DirectionalLight&) { return "irradiance"; },
+                                 [](const ConstantLight&) { return "radiance"; }},
+                      m);
+}
+
+bool same_light(const Light& a, const Light& b) {
+    if (a.model.index() != b.model.index() || light_strength(a.model) != light_strength(b.model)) return false;
+    return std::visit(
+        overloaded{[&](const PointLight& l) { return l.position == std::get<PointLight>(b.model).position; },
+                   [&](const SpotLight& l) {
+                       const SpotLight& o = std::get<SpotLight>(b.model);
+                       return l.to_world == o.to_world && l.cutoff_angle == o.cutoff_angle &&
+                              l.beam_width == o.beam_width && l.texture == o.texture;
+                   },
+                   [&](const DirectionalLight& l) { return l.direction == std::get<DirectionalLight>(b.model).direction; },
+                   [&](const ConstantLight&) { return true; }},
+        a.model);
+}
+
+bool sample_li(const LightModel& m, const SceneSphere& sphere, vec3 ref_p, vec2 u, LightSample& out) {
+    (void)sphere;
+    return std::visit(
+        overloaded{
+            [&](const PointLight& l) {
+                vec3 d = l.position - ref_p;
+                float d2 = glm::dot(d, d);
+                if (!(d2 > 0.f)) return false;
+                out.dist = std::sqrt(d2);
+                out.wi = d / out.dist;
+                out.p = l.position;
+                out.p_error = vec3(0.f);
+                out.n = vec3(0.f);
+                out.Le = l.intensity / d2;
+                out.pdf = 1.f;
+                out.delta = true;
+                out.infinite = false;
+                return true;
+            },
+            [&](const SpotLight& l) {
+                vec3 pos = l.position();
+                vec3 d = pos - ref_p;
+                float d2 = glm::dot(d, d);
+                if (!(d2 > 0.f)) return false;
+                out.dist = std::sqrt(d2);
+                out.wi = d / out.dist;
+                vec3 prof = l.profile(l.to_local(-out.wi));
+                if (is_black(prof)) return false;
+                out.p = pos;
+                out.p_error = vec3(0.f);
+                out.n = vec3(0.f);
+                out.Le = l.intensity * prof / d2;
+                out.pdf = 1.f;
+                out.delta = true;
+                out.infinite = false;
+                return true;
+            },
+            [&](const DirectionalLight& l) {
+                out.wi = -l.direction;
+                out.dist = kInfinity;
+                out.p = ref_p;
+                out.n = l.direction;
+                out.Le = l.irradiance;
+                out.pdf = 1.f;
+                out.delta = true;
+                out.infinite = true;
+                return true;
+            },
+            [&](const ConstantLight& l) {
+                out.wi = square_to_uniform_sphere(u);
+                out.dist = kInfinity;
+                out.p = ref_p;
+                out.n = -out.wi;
+                out.Le = l.radiance;
+                out.pdf = kInv4Pi;
+                out.delta = false;
+                out.infinite = true;
+                return true;
+            }},
+        m);
+}
+
+float pdf_li(const LightModel& m, vec3) {
+    return std::holds_alternative<ConstantLight>(m) ? kInv4Pi : 0.f;
+}
+
+vec3 eval_infinite(const LightModel& m, vec3) {
+    if (const ConstantLight* c = std::get_if<ConstantLight>(&m)) return c->radiance;
+    return vec3(0.f);
+}
+
+std::optional<EmissionSample> sample_le(const LightModel& m, const SceneSphere& sphere, vec2 u_pos, vec2 u_dir) {
+    EmissionSample es;
+    es.flags = light_flags(m);
+    bool ok = std::visit(
+        overloaded{[&](const PointLight& l) {
+                       es.ray.o = l.position;
+                       es.ray.d = square_to_uniform_sphere(u_dir);
+                       es.Le = l.intensity;
+                       es.pdf_pos = 1.f;
+                       es.pdf_dir = kInv4Pi;
+                       return true;
+                   },
+                   [&](const SpotLight& l) {
+                       const float cos_cutoff = std::cos(radians(l.cutoff_angle));
+                       vec3 local = square_to_uniform_cone(u_dir, cos_cutoff);
+                       es.ray.o = l.position();
+                       es.ray.d = glm::normalize(glm::mat3(l.to_world) * local);
+                       es.Le = l.intensity * l.profile(local);
+                       es.pdf_pos = 1.f;
+                       es.pdf_dir = square_to_uniform_cone_pdf(local, cos_cutoff);
+                       return es.pdf_dir > 0.f;
+                   },
+                   [&](const DirectionalLight& l) {
+                       // From the disk facing the light, one radius before the centre.
+                       es.ray.o = disk_point(sphere, -l.direction, u_pos) - sphere.radius * l.direction;
+                       es.ray.d = l.direction;
+                       es.n = l.direction;
+                       es.Le = l.irradiance;
+                       es.pdf_pos = 1.f / (kPi * sphere.radius * sphere.radius);
+                       es.pdf_dir = 1.f;
+                       return true;
+                   },
+                   [&](const ConstantLight& l) {
+                       vec3 w = square_to_uniform_sphere(u_dir);  // towards the light
+                       es.ray.o = disk_point(sphere, w, u_pos) + sphere.radius * w;
+                       es.ray.d = -w;
+                       es.n = -w;
+                       es.Le = l.radiance;
+                       es.pdf_pos = 1.f / (kPi * sphere.radius * sphere.radius);
+                       es.pdf_dir = kInv4Pi;
+                       return true;
+                   }},
+        m);
+    if (!ok) return std::nullopt;
+    return es;
+}
+
+void pdf_le(const LightModel& m, const SceneSphere& sphere, vec3 d, float& pdf_pos, float& pdf_dir) {
+    const float disk = 1.f / (kPi * sphere.radius * sphere.radius);
+    std::visit(overloaded{[&](const PointLight&) {
+                              pdf_pos = 1.f;
+                              pdf_dir = kInv4Pi;
+                          },
+                          [&](const SpotLight& l) {
+                              pdf_pos = 1.f;
+                              pdf_dir = square_to_uniform_cone_pdf(l.to_local(d), std::cos(radians(l.cutoff_angle)));
+                          },
+                          [&](const DirectionalLight&) {
+                              pdf_pos = disk;
+                              pdf_dir = 1.f;
+                          },
+                          [&](const ConstantLight&) {
+                              pdf_pos = disk;
+                              pdf_dir = kInv4Pi;
+                          }},
+               m);
+}
+
+}  // namespace candela
