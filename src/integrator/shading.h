@@ -26,7 +26,8 @@ struct ShadingT {
     vec3 wo{0.f};
     const Bsdf* bsdf = nullptr;     // the plain material's BSDF (textured copy in scratch[0])
     bool is_wrapped = false;
-    WrappedBsdf wrapped;
+    struct None {};
+    std::conditional_t<DiffuseOnly, None, WrappedBsdf> wrapped;  // not even constructed in diffuse-only
     std::array<Bsdf, DiffuseOnly ? 1 : kMaxBlendLeaves> scratch;
 
     vec3 eval(vec3 wi, TransportMode mode = TransportMode::Radiance) const {
@@ -134,11 +135,8 @@ inline bool scene_has_masks(const Scene& sc) {
     return false;
 }
 
-// The fraction of light that travels along a shadow ray (from spawn_ray_to): 0 when an unmasked
-// surface is in the way, else the product of (1 - opacity) over the masked surfaces crossed.
-// Without masks in the scene this is the plain any-hit test.
-inline float shadow_transmittance(const Scene& sc, Ray shadow, bool masks, uint64_t& rays) {
-    if (!masks) return sc.accel->occluded(shadow) ? 0.f : 1.f;
+// The loop over masked surfaces, out of line: scenes without masks never run it.
+inline __attribute__((noinline)) float shadow_transmittance_masked(const Scene& sc, Ray shadow, uint64_t& rays) {
     // To a point (spawn_ray_to: tmax = 1 - eps stops just short of o + d), or towards an infinite
     // light (spawn_ray: unbounded).
     const bool to_point = std::isfinite(shadow.tmax);
@@ -160,6 +158,14 @@ inline float shadow_transmittance(const Scene& sc, Ray shadow, bool masks, uint6
         ++rays;
     }
     return 0.f;  // a pile of masks deeper than any scene needs: treat as opaque
+}
+
+// The fraction of light that travels along a shadow ray (from spawn_ray_to): 0 when an unmasked
+// surface is in the way, else the product of (1 - opacity) over the masked surfaces crossed.
+// Without masks in the scene this is the plain any-hit test.
+inline float shadow_transmittance(const Scene& sc, const Ray& shadow, bool masks, uint64_t& rays) {
+    if (!masks) return sc.accel->occluded(shadow) ? 0.f : 1.f;
+    return shadow_transmittance_masked(sc, shadow, rays);
 }
 
 }  // namespace candela
