@@ -10,11 +10,13 @@
 //           probability of that lobe and f carries the Dirac's weight, so only f / pdf matters.
 // TransportMode says which quantity flows along the path: Radiance (camera paths) or Importance
 // (light paths, for bidirectional methods), for the non-symmetric scaling of refraction.
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
 #include <variant>
+#include <vector>
 #include "bsdf/conductor.h"
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
@@ -120,32 +122,84 @@ struct TextureSlot {
     const char* parameter = "";  // Mitsuba's name, for the viewer
 };
 
+// One BSDF of a material and its textured parameters (a leaf of a blendbsdf tree).
+struct MaterialLeaf {
+    Bsdf bsdf;
+    std::vector<TextureSlot> textures;
+};
+
+// Mitsuba's `blendbsdf` node: (1 - w) child[0] + w child[1], w = weight (or the texture's eval_1
+// clamped to [0, 1]). A child >= 0 is another node of Material::blend, a child < 0 is leaf -1 - c
+// (leaf 0 is Material::bsdf/textures, leaf k > 0 is Material::extra_leaves[k - 1]).
+struct BlendNode {
+    float weight = 0.5f;
+    std::shared_ptr<const Texture> weight_texture;  // null: `weight` is the value
+    int child[2] = {-1, -1};
+};
+
+// The shading-normal wrappers (Mitsuba 3.9's bumpmap and normalmap, both on src/bsdfs/perturbed_bsdf.h).
+enum class Perturbation { None, Bump, Normal };
+
 // A material as scenes name it: a BSDF plus whether both sides of the surface scatter.
 // Mitsuba's BSDFs are one-sided (black from the back) unless wrapped in `twosided`; plain OBJ+MTL
 // scenes are two-sided, as users of those files expect. Textured parameters are in `textures`:
 // `bsdf` holds the rest (and, for those, values that bsdf_at overwrites at each point).
+//
+// Wrappers (docs/materials.md, "Wrappers"). A plain material (no wrapper: plain() is true) is one
+// BSDF and the integrators treat it exactly as before the wrappers existed. Otherwise it is a small
+// tree kept flat: `blend` nodes over leaves (blendbsdf), at most one shading-normal perturbation
+// (bumpmap or normalmap) and an opacity (mask; null is opacity 0) applied to the whole tree. Only
+// materials with a wrapper go through the mixture code (integrator/shading.h).
 struct Material {
     std::string name;
     Bsdf bsdf;
     bool two_sided = false;
     std::vector<TextureSlot> textures;
 
+    std::vector<MaterialLeaf> extra_leaves;  // leaves 1.. of the blend tree
+    std::vector<BlendNode> blend;            // blend[0] is the root when not empty
+    Perturbation perturbation = Perturbation::None;
+    std::shared_ptr<const Texture> perturbation_texture;  // bump height (eval_1) or tangent-space normal
+    float bump_scale = 1.f;                  // bumpmap `scale`
+    bool shadow_terminator = true;           // Mitsuba's use_shadowing_function (Estevez et al. 2019)
+    bool flip_invalid_normals = true;        // Mitsuba's flip_invalid_normals
+    bool masked = false;                     // mask or null: the surface lets part of the light through
+    float opacity = 1.f;                     // mask `opacity` in [0, 1] (null: 0)
+    std::shared_ptr<const Texture> opacity_texture;  // null: `opacity` is the value
+
     bool textured() const { return !textures.empty(); }
+    bool plain() const { return blend.empty() && perturbation == Perturbation::None && !masked; }
     bool uses_vertex_colors() const {
+        auto reads = [](const std::shared_ptr<const Texture>& t) { return t && t->uses_vertex_colors(); };
         for (const TextureSlot& t : textures)
-            if (t.texture->uses_vertex_colors()) return true;
-        return false;
+            if (reads(t.texture)) return true;
+        for (const MaterialLeaf& l : extra_leaves)
+            for (const TextureSlot& t : l.textures)
+                if (reads(t.texture)) return true;
+        for (const BlendNode& b : blend)
+            if (reads(b.weight_texture)) return true;
+        return reads(perturbation_texture) || reads(opacity_texture);
+    }
+    // The opacity at a point (1 for an unmasked material): Mitsuba's mask, eval_1 clamped to [0, 1].
+    float opacity_at(const TextureQuery& q) const {
+        if (!masked) return 1.f;
+        if (!opacity_texture) return opacity;
+        return std::clamp(opacity_texture->eval_1(q), 0.f, 1.f);
     }
 };
 
-// The material's BSDF at a surface point: the material's own when nothing is textured (no copy, the
-// case of every untextured scene), else a copy in `scratch` with its textured parameters evaluated
-// at `q`.
-inline const Bsdf& bsdf_at(const Material& m, const TextureQuery& q, Bsdf& scratch) {
-    if (!m.textured()) return m.bsdf;
-    scratch = m.bsdf;
-    for (const TextureSlot& t : m.textures) t.apply(scratch, t.texture->eval(q));
+// A leaf's BSDF at a surface point: its own when nothing is textured (no copy, the case of every
+// untextured scene), else a copy in `scratch` with its textured parameters evaluated at `q`.
+inline const Bsdf& bsdf_at(const Bsdf& b, const std::vector<TextureSlot>& textures, const TextureQuery& q,
+                           Bsdf& scratch) {
+    if (textures.empty()) return b;
+    scratch = b;
+    for (const TextureSlot& t : textures) t.apply(scratch, t.texture->eval(q));
     return scratch;
+}
+// The material's first (for a plain material: only) BSDF at a surface point.
+inline const Bsdf& bsdf_at(const Material& m, const TextureQuery& q, Bsdf& scratch) {
+    return bsdf_at(m.bsdf, m.textures, q, scratch);
 }
 
 }  // namespace candela

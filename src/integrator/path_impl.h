@@ -51,9 +51,12 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const bool have_lights = !sc.lights.empty();
     vec3 L(0.f), beta(1.f);
     bool after_delta = true;     // camera rays and delta bounces: emission always counts fully
-    float prev_pdf = 0.f;        // solid-angle pdf of the BSDF sample that led here
+    float prev_pdf = 0.f;        // solid-angle pdf of the BSDF sample that led here (times the
+                                 // probabilities of the mask pass-throughs since)
     vec3 prev_p(0.f);
     float eta_scale = 1.f;       // product of eta^2 over refractions: undoes their radiance scaling
+    ShadingT<DiffuseOnly> sh;
+    int passes = 0;              // mask pass-throughs (bounded, as skip_area_emitters)
 
     for (int depth = 0;; ++depth) {
         Hit hit;
@@ -68,7 +71,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         // A camera ray that goes on through hidden area emitters and leaves sees no infinite light
         // either (it is still at depth 0).
         if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, ray, hit, stats)) break;
-        if (depth == 0) ++stats.camera_hits;
+        if (depth == 0 && passes == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
         vec3 wo_world = -glm::normalize(ray.d);
 
@@ -84,38 +87,39 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                 }  // Light mode: this path was already counted by light sampling.
             }
         }
+        if constexpr (!DiffuseOnly) {
+            if (masks_) {  // pass straight through with probability 1 - opacity (not a vertex)
+                const Material& m = sc.materials[sc.shapes[si.shape].material];
+                const float a = m.opacity_at(m.masked ? sc.texture_query(si, hit) : TextureQuery{});
+                if (a < 1.f && sampler.next_1d() >= a) {
+                    if (++passes > 1024) break;
+                    prev_pdf *= 1.f - a;
+                    ray = spawn_ray(si, ray.d);
+                    --depth;
+                    continue;
+                }
+            }
+        }
         if (st.max_depth >= 0 && depth >= st.max_depth) break;
 
-        const Shape& shape = sc.shapes[si.shape];
-        const Material& mat = sc.materials[shape.material];
-        Bsdf textured;
-        const Bsdf& bsdf = mat.textured() ? bsdf_at(mat, sc.texture_query(si, hit), textured) : mat.bsdf;
-        // Shading frame; a two-sided material is seen from whichever side the ray arrives.
-        vec3 n = si.ns;
-        if (mat.two_sided && glm::dot(wo_world, n) < 0.f) {
-            n = -n;
-            si.ng = -si.ng;
-        }
-        Frame frame(n);
-        vec3 wo = frame.to_local(wo_world);
+        shade<DiffuseOnly>(sc, hit, si, wo_world, sh);
 
         // Next-event estimation.
-        if (mode != SamplingMode::Bsdf && have_lights && has_smooth_component_in<DiffuseOnly>(bsdf)) {
+        if (mode != SamplingMode::Bsdf && have_lights && sh.has_smooth_component()) {
             float ul = sampler.next_1d();
             vec2 up = sampler.next_2d();
             LightSample ls;
             if (sc.lights.sample_li(si.p, ul, up, ls)) {
-                vec3 wi = frame.to_local(ls.wi);
-                vec3 f = eval_in<DiffuseOnly>(bsdf, wo, wi);
+                vec3 wi = sh.frame.to_local(ls.wi);
+                vec3 f = sh.eval(wi);
                 if (!is_black(f)) {
                     Ray shadow = shadow_ray(si, ls);
                     ++stats.rays;
-                    if (!sc.accel->occluded(shadow)) {
+                    const float T = shadow_transmittance(sc, shadow, !DiffuseOnly && masks_, stats.rays);
+                    if (T > 0.f) {
                         // A delta light cannot be reached by BSDF sampling: no MIS.
-                        float w = mode == SamplingMode::Mis && !ls.delta
-                                      ? power_heuristic(ls.pdf, pdf_in<DiffuseOnly>(bsdf, wo, wi))
-                                      : 1.f;
-                        L += beta * f * ls.Le * (w / ls.pdf);
+                        float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, sh.pdf(wi) * T) : 1.f;
+                        L += beta * f * ls.Le * (T * w / ls.pdf);
                     }
                 }
             }
@@ -128,7 +132,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         // Continue the path by sampling the BSDF.
         float u1 = sampler.next_1d();
         vec2 u2 = sampler.next_2d();
-        std::optional<BsdfSample> bs = sample_in<DiffuseOnly>(bsdf, wo, u1, u2);
+        std::optional<BsdfSample> bs = sh.sample(u1, u2);
         if (!bs || !(bs->pdf > 0.f)) break;
         beta *= bs->weight();
         if (is_black(beta)) break;
@@ -136,7 +140,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         after_delta = bs->delta;
         prev_pdf = bs->pdf;
         prev_p = si.p;
-        vec3 wi_world = frame.to_world(bs->wi);
+        vec3 wi_world = sh.frame.to_world(bs->wi);
         ray = spawn_ray(si, wi_world);
 
         if (depth + 1 >= st.rr_depth) {

@@ -116,6 +116,31 @@ vec3 BitmapTexture::eval(const TextureQuery& q) const {
     return (1.f - wy) * v0 + wy * v1;
 }
 
+float CheckerboardTexture::eval_1(const TextureQuery& q) const {
+    vec2 uv = to_uv.apply(q.uv);
+    const bool mu = uv.x - std::floor(uv.x) > 0.5f, mv = uv.y - std::floor(uv.y) > 0.5f;
+    return mu == mv ? color1->eval_1(q) : color0->eval_1(q);
+}
+
+vec2 BitmapTexture::eval_1_grad(const TextureQuery& q) const {
+    if (filter == TextureFilter::Nearest) return vec2(0.f);
+    const TexelGrid& g = *texels;
+    const vec2 uv = to_uv.apply(q.uv);
+    const float px = uv.x * float(g.width) - 0.5f, py = uv.y * float(g.height) - 0.5f;
+    const int x0 = floor_to_int(px), y0 = floor_to_int(py);
+    const float wx = px - float(x0), wy = py - float(y0);
+    const int xa = wrap_index(x0, g.width, wrap), xb = wrap_index(x0 + 1, g.width, wrap);
+    const int ya = wrap_index(y0, g.height, wrap), yb = wrap_index(y0 + 1, g.height, wrap);
+    const float f00 = luminance(g.texel(xa, ya)), f10 = luminance(g.texel(xb, ya));
+    const float f01 = luminance(g.texel(xa, yb)), f11 = luminance(g.texel(xb, yb));
+    // Per texel in x and y, then to (u, v): d(x, y)/d(u, v) = resolution * to_uv's linear part.
+    const float dfx = (1.f - wy) * (f10 - f00) + wy * (f11 - f01);
+    const float dfy = (1.f - wx) * (f01 - f00) + wx * (f11 - f10);
+    const glm::mat3& m = to_uv.m;  // column-major: m[c][r]
+    const float gx = dfx * float(g.width), gy = dfy * float(g.height);
+    return vec2(m[0][0] * gx + m[0][1] * gy, m[1][0] * gx + m[1][1] * gy);
+}
+
 vec3 CheckerboardTexture::eval(const TextureQuery& q) const {
     vec2 uv = to_uv.apply(q.uv);
     const bool mu = uv.x - std::floor(uv.x) > 0.5f, mv = uv.y - std::floor(uv.y) > 0.5f;

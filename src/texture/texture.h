@@ -53,6 +53,10 @@ struct BitmapTexture {
     std::string name;  // file name, for messages and the viewer
 
     vec3 eval(const TextureQuery& q) const;
+    // d eval_1 / d(u, v), as Mitsuba's bitmap eval_1_grad: the derivative of the bilinear
+    // interpolation of the luminance within the texel cell around uv (times the resolution and
+    // through to_uv); 0 for nearest filtering (piecewise constant).
+    vec2 eval_1_grad(const TextureQuery& q) const;
 };
 
 struct Texture;
@@ -64,6 +68,11 @@ struct CheckerboardTexture {
     UvTransform to_uv;
 
     vec3 eval(const TextureQuery& q) const;
+    // The scalar a float parameter (blendbsdf weight, mask opacity, bump height) reads. Mitsuba
+    // 3.9.1's checkerboard eval_1 has the two colours the other way round from its eval (color1
+    // where eval gives color0; checked with its Python bindings): candela follows it, so that a
+    // checkerboard weight or opacity means what it means in Mitsuba scenes.
+    float eval_1(const TextureQuery& q) const;
 };
 
 // Mitsuba's `mesh_attribute` with name "vertex_color": the mesh's interpolated vertex colours.
@@ -81,7 +90,17 @@ struct Texture {
             else return t.eval(q);
         }, v);
     }
-    float eval_1(const TextureQuery& q) const { return luminance(eval(q)); }
+    float eval_1(const TextureQuery& q) const {
+        if (const CheckerboardTexture* c = std::get_if<CheckerboardTexture>(&v)) return c->eval_1(q);
+        return luminance(eval(q));
+    }
+    // The gradient of eval_1 in uv (bumpmap's height slope). Only a bitmap varies smoothly; a
+    // constant, a checkerboard (piecewise constant) and vertex colours (not a function of uv)
+    // give 0.
+    vec2 eval_1_grad(const TextureQuery& q) const {
+        if (const BitmapTexture* b = std::get_if<BitmapTexture>(&v)) return b->eval_1_grad(q);
+        return vec2(0.f);
+    }
     bool is_constant() const { return std::holds_alternative<ConstantTexture>(v); }
     // Whether it reads the mesh's vertex colours (the mesh must then store them).
     bool uses_vertex_colors() const;

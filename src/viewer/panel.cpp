@@ -92,6 +92,21 @@ bool edit_material(Material& m) {
     // A textured parameter takes its value from the texture at each point: its slider has no effect.
     for (const TextureSlot& t : m.textures) ImGui::TextDisabled("%s: a texture (the slider above has no effect)", t.parameter);
     changed |= ImGui::Checkbox("two-sided", &m.two_sided);
+    // The wrappers' own parameters (docs/materials.md): the blend weights, the opacity, the bump
+    // scale. The leaves of a blend beyond the first are not listed (their BSDF sliders would need
+    // a tree view); a textured weight or opacity has no slider.
+    for (size_t i = 0; i < m.blend.size(); ++i) {
+        ImGui::PushID(int(i));
+        if (m.blend[i].weight_texture) ImGui::TextDisabled("blend weight %zu: a texture", i);
+        else changed |= ImGui::SliderFloat("blend weight", &m.blend[i].weight, 0.f, 1.f, "%.3f");
+        ImGui::PopID();
+    }
+    if (m.masked) {
+        if (m.opacity_texture) ImGui::TextDisabled("opacity: a texture");
+        else changed |= ImGui::SliderFloat("opacity", &m.opacity, 0.f, 1.f, "%.3f");
+    }
+    if (m.perturbation == Perturbation::Bump) changed |= ImGui::DragFloat("bump scale", &m.bump_scale, 0.005f, -10.f, 10.f, "%.4f");
+    if (m.perturbation != Perturbation::None) changed |= ImGui::Checkbox("shadow terminator", &m.shadow_terminator);
     return changed;
 }
 

@@ -1,4 +1,5 @@
 #include "integrator/aov/aov.h"
+#include "integrator/shading.h"
 
 namespace candela {
 
@@ -60,12 +61,15 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
             case AovType::ShapeIndex: *o++ = float(si.shape); break;
             case AovType::Moment: o += aov_channel_count(AovType::Moment); break;  // write_moment's
             case AovType::Albedo: {
-                const Material& mat = scene.materials[scene.shapes[si.shape].material];
-                vec3 n = si.ns;
-                if (mat.two_sided && glm::dot(d, n) > 0.f) n = -n;  // seen from the side the ray comes from
-                Bsdf textured;
-                const Bsdf& bsdf = mat.textured() ? bsdf_at(mat, scene.texture_query(si, hit), textured) : mat.bsdf;
-                vec3 rho = diffuse_reflectance(bsdf, Frame(n).to_local(-d));
+                // Mitsuba's blendbsdf returns the blend of its children's values, the other
+                // wrappers their nested BSDF's: the mixture of the leaves, unperturbed.
+                SurfaceInteraction s = si;
+                ShadingT<false> sh;
+                shade<false>(scene, hit, s, -d, sh);
+                vec3 rho(0.f);
+                if (!sh.is_wrapped) rho = diffuse_reflectance(*sh.bsdf, sh.wo);
+                else
+                    for (int k = 0; k < sh.wrapped.n; ++k) rho += sh.wrapped.w[size_t(k)] * diffuse_reflectance(*sh.wrapped.leaf[size_t(k)], sh.wo);
                 for (int k = 0; k < 3; ++k) *o++ = rho[k];
                 break;
             }

@@ -39,6 +39,7 @@ private:
     int n_light_, n_bsdf_;
     float frac_light_, frac_bsdf_;      // n_l / (n_l + n_b), n_b / (n_l + n_b)
     float weight_light_, weight_bsdf_;  // 1 / n_l, 1 / n_b
+    bool masks_;                        // some material is masked (shading.h)
 };
 
 class DirectPass final : public Integrator {
@@ -47,7 +48,7 @@ public:
                           const std::atomic<bool>* cancel) const override;
 };
 
-inline DirectIntegrator::DirectIntegrator(const Scene& scene) : scene_(scene) {
+inline DirectIntegrator::DirectIntegrator(const Scene& scene) : scene_(scene), masks_(scene_has_masks(scene)) {
     const IntegratorDesc& d = scene.settings.integrator;
     n_light_ = d.emitter_samples;
     n_bsdf_ = d.bsdf_samples;
@@ -70,44 +71,50 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         return Le;
     }
     if (hide && !skip_area_emitters(sc, ray, hit, stats)) return vec3(0.f);
-    ++stats.camera_hits;  // the film's alpha
     SurfaceInteraction si = sc.interaction(hit);
+    if constexpr (!DiffuseOnly) {
+        // The camera ray passes masked surfaces with probability 1 - opacity (as in the path tracer).
+        for (int k = 0; masks_ && k < 1024; ++k) {
+            const Material& m = sc.materials[sc.shapes[si.shape].material];
+            if (!m.masked || sampler.next_1d() < m.opacity_at(sc.texture_query(si, hit))) break;
+            ray = spawn_ray(si, ray.d);
+            hit = Hit();
+            ++stats.rays;
+            if (!sc.accel->intersect(ray, hit)) return vec3(0.f);
+            if (hide && !skip_area_emitters(sc, ray, hit, stats)) return vec3(0.f);
+            si = sc.interaction(hit);
+        }
+    }
+    ++stats.camera_hits;  // the film's alpha
     const vec3 wo_world = -glm::normalize(ray.d);
     vec3 L(0.f);
     if (!hide && sc.lights.emitter_of(hit) >= 0) L += sc.lights.emitted(si, wo_world);
     if (sc.lights.empty()) return L;
 
-    const Material& mat = sc.materials[sc.shapes[si.shape].material];
-    Bsdf textured;
-    const Bsdf& bsdf = mat.textured() ? bsdf_at(mat, sc.texture_query(si, hit), textured) : mat.bsdf;
-    vec3 n = si.ns;
-    if (mat.two_sided && glm::dot(wo_world, n) < 0.f) {
-        n = -n;
-        si.ng = -si.ng;
-    }
-    const Frame frame(n);
-    const vec3 wo = frame.to_local(wo_world);
+    ShadingT<DiffuseOnly> sh;
+    shade<DiffuseOnly>(sc, hit, si, wo_world, sh);
+    const Frame& frame = sh.frame;
+    const bool masks = !DiffuseOnly && masks_;
 
-    if (has_smooth_component_in<DiffuseOnly>(bsdf)) {
+    if (sh.has_smooth_component()) {
         for (int i = 0; i < n_light_; ++i) {
             float ul = sampler.next_1d();
             vec2 up = sampler.next_2d();
             LightSample ls;
             if (!sc.lights.sample_li(si.p, ul, up, ls) || !(ls.pdf > 0.f)) continue;
             const vec3 wi = frame.to_local(ls.wi);
-            const vec3 f = eval_in<DiffuseOnly>(bsdf, wo, wi);
+            const vec3 f = sh.eval(wi);
             if (is_black(f)) continue;
             Ray shadow = shadow_ray(si, ls);
             ++stats.rays;
-            if (sc.accel->occluded(shadow)) continue;
+            const float T = shadow_transmittance(sc, shadow, masks, stats.rays);
+            if (!(T > 0.f)) continue;
             // A delta light: weight 1, exactly as Mitsuba 3.9's direct.cpp (`select(ds.delta, 1,
             // mis_weight(...) * m_weight_lum)`): it is NOT divided by emitter_samples, so with n_l
             // light samples a delta light counts n_l times. Kept for agreement with Mitsuba
             // (docs/lights.md); the smooth lights get 1 / n_l.
-            const float w = ls.delta ? 1.f
-                                     : mis_weight(ls.pdf * frac_light_, pdf_in<DiffuseOnly>(bsdf, wo, wi) * frac_bsdf_) *
-                                           weight_light_;
-            L += f * ls.Le * (w / ls.pdf);
+            const float w = ls.delta ? 1.f : mis_weight(ls.pdf * frac_light_, sh.pdf(wi) * frac_bsdf_) * weight_light_;
+            L += f * ls.Le * (T * w / ls.pdf);
         }
     } else {
         for (int i = 0; i < n_light_; ++i) {  // keep the sample dimensions aligned
@@ -119,14 +126,29 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     for (int i = 0; i < n_bsdf_; ++i) {
         float u1 = sampler.next_1d();
         vec2 u2 = sampler.next_2d();
-        std::optional<BsdfSample> bs = sample_in<DiffuseOnly>(bsdf, wo, u1, u2);
+        std::optional<BsdfSample> bs = sh.sample(u1, u2);
         if (!bs || !(bs->pdf > 0.f)) continue;
-        const vec3 beta = bs->weight();
+        vec3 beta = bs->weight();
         if (is_black(beta)) continue;
         Ray r = spawn_ray(si, frame.to_world(bs->wi));
         Hit h;
         ++stats.rays;
-        if (!sc.accel->intersect(r, h)) {
+        // The BSDF ray crosses masked surfaces with their transmittance (deterministically, like the
+        // shadow rays: both strategies then have the densities p_bsdf and p_light in the MIS weights).
+        bool found = sc.accel->intersect(r, h);
+        for (int k = 0; masks && found && k < 256; ++k) {
+            const SurfaceInteraction sm = sc.interaction(h);
+            const Material& m = sc.materials[sc.shapes[sm.shape].material];
+            if (!m.masked || sc.lights.emitter_of(h) >= 0) break;
+            beta *= 1.f - m.opacity_at(sc.texture_query(sm, h));
+            if (is_black(beta)) break;
+            r = spawn_ray(sm, r.d);
+            h = Hit();
+            ++stats.rays;
+            found = sc.accel->intersect(r, h);
+        }
+        if (is_black(beta)) continue;
+        if (!found) {
             // Escaped: the infinite lights, each weighted against its own sampling density.
             sc.lights.for_each_infinite(glm::normalize(r.d), [&](vec3 Le, float light_pdf) {
                 if (bs->delta) light_pdf = 0.f;

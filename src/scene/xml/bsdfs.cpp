@@ -177,6 +177,11 @@ const PluginTable<BsdfFactory>& bsdf_plugins() {
         {"dielectric", make_dielectric},
         {"roughdielectric", make_roughdielectric},
         {"twosided", make_twosided},
+        {"blendbsdf", blendbsdf_factory()},
+        {"mask", mask_factory()},
+        {"null", null_factory()},
+        {"bumpmap", bumpmap_factory()},
+        {"normalmap", normalmap_factory()},
     };
     return table;
 }

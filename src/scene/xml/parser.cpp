@@ -757,6 +757,11 @@ Material XmlLoader::nested_bsdf(Object& wrapper) {
         inner = &c;
     }
     if (!inner) throw error(wrapper.node, wrapper.what() + " needs a nested <bsdf>");
+    return nested_bsdf(wrapper, *inner);
+}
+
+Material XmlLoader::nested_bsdf(Object&, Nested& c) {
+    Nested* inner = &c;
     inner->used = true;
     if (inner->tag == "ref") {
         definition(*inner, "bsdf");

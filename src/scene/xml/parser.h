@@ -124,6 +124,9 @@ public:
     uint32_t material_for(Object& shape);
     // The one <bsdf> (or <ref> to one) nested in a wrapper such as twosided, built by its factory.
     Material nested_bsdf(Object& wrapper);
+    // The material of one nested <bsdf> or <ref> of `wrapper` (marks it used): for wrappers with
+    // several nested BSDFs (blendbsdf).
+    Material nested_bsdf(Object& wrapper, Nested& inner);
 
 private:
     // One parsed file: the main scene or an included one. Nodes of every document stay valid

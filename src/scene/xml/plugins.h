@@ -10,6 +10,12 @@ namespace xml {
 // ---- bsdfs.cpp: <bsdf> -> Material (the name is set by the caller) ----
 using BsdfFactory = Material (*)(XmlLoader&, Object&);
 const PluginTable<BsdfFactory>& bsdf_plugins();
+// bsdf_wrappers.cpp: blendbsdf, mask, null, bumpmap, normalmap (rows of bsdf_plugins()).
+BsdfFactory blendbsdf_factory();
+BsdfFactory mask_factory();
+BsdfFactory null_factory();
+BsdfFactory bumpmap_factory();
+BsdfFactory normalmap_factory();
 
 // ---- shapes.cpp: <shape> -> triangles in object space, then placed by the common code ----
 struct ShapeGeometry {
