@@ -37,24 +37,28 @@ ConductorBsdf gold(float alpha) {
     ConductorBsdf c;
     c.eta = vec3(0.143f, 0.374f, 1.442f);  // approximate RGB values for gold
     c.k = vec3(3.983f, 2.385f, 1.603f);
-    c.alpha = alpha;
+    c.distribution = MicrofacetType::GGX;
+    c.alpha_u = c.alpha_v = alpha;
     return c;
 }
 ConductorBsdf mirror(float alpha) {
     ConductorBsdf c;
-    c.alpha = alpha;
+    c.distribution = MicrofacetType::GGX;
+    c.alpha_u = c.alpha_v = alpha;
     return c;
 }
 DielectricBsdf glass(float alpha, float ior = 1.5f) {
     DielectricBsdf d;
     d.int_ior = ior;
     d.ext_ior = 1.f;
-    d.alpha = alpha;
+    d.distribution = MicrofacetType::GGX;
+    d.alpha_u = d.alpha_v = alpha;
     return d;
 }
 PlasticBsdf plastic(float alpha, vec3 rho = vec3(0.5f)) {
     PlasticBsdf p;
     p.alpha = alpha;
+    p.distribution = MicrofacetType::GGX;
     p.diffuse_reflectance = rho;
     return p;
 }
@@ -66,8 +70,8 @@ PlasticBsdf plastic(float alpha, vec3 rho = vec3(0.5f)) {
 const float kCosines[] = {0.95f, 0.5f, 0.15f, 0.04f};
 
 float roughness(const Bsdf& b) {
-    if (auto* c = std::get_if<ConductorBsdf>(&b)) return c->alpha;
-    if (auto* d = std::get_if<DielectricBsdf>(&b)) return d->alpha;
+    if (auto* c = std::get_if<ConductorBsdf>(&b)) return std::min(c->alpha_u, c->alpha_v);
+    if (auto* d = std::get_if<DielectricBsdf>(&b)) return std::min(d->alpha_u, d->alpha_v);
     if (auto* p = std::get_if<PlasticBsdf>(&b)) return p->alpha;
     return 1.f;
 }
