@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
+#include "accel/with_analytic.h"
 #include "core/error.h"
 #include "film/film.h"
 #include "film/image_io.h"
@@ -699,4 +700,57 @@ TEST(AnalyticShapes, MitsubaAgreementDetectsDimmerSphereLight) {
     double p = whole_image_p(test, ref, nullptr);
     std::printf("  sphere light 3%% dimmer: blocks %s, whole image p = %.3g\n", r.describe().c_str(), p);
     EXPECT_TRUE(!r.passed(kAlpha) || p < kAlpha);
+}
+
+// The analytic shapes sit in a BVH over their boxes: for thousands of overlapping spheres, disks and
+// cylinders, closest hits and shadow tests must be exactly those of testing every shape in turn.
+TEST(AnalyticShapes, BvhOverShapesEqualsTestingEachShape) {
+    PCG32 rng(7, 11);
+    auto u = [&] { return rng.next_float(); };
+    std::vector<AnalyticShape> shapes;
+    for (int i = 0; i < 3000; ++i) {
+        vec3 c(20.f * u() - 10.f, 20.f * u() - 10.f, 20.f * u() - 10.f);
+        if (i % 3 == 0) shapes.push_back(make_sphere(mat4(1.f), c, 0.05f + 0.5f * u(), false));
+        else if (i % 3 == 1)
+            shapes.push_back(make_disk(translation(c) * rotation(360.f * u(), glm::normalize(vec3(u(), u(), u()) + 0.1f)) *
+                                           scaling(vec3(0.1f + 0.4f * u())),
+                                       false));
+        else
+            shapes.push_back(make_cylinder(mat4(1.f), c, c + vec3(u() - 0.5f, u() - 0.5f, u() - 0.5f), 0.05f + 0.2f * u(), false));
+    }
+    Mesh empty;
+    WithAnalyticAccel accel(make_accel("kdtree", empty), shapes);
+    int hits = 0, blocked = 0;
+    for (int r = 0; r < 4000; ++r) {
+        Ray ray;
+        ray.o = vec3(30.f * u() - 15.f, 30.f * u() - 15.f, 30.f * u() - 15.f);
+        ray.d = glm::normalize(vec3(u() - 0.5f, u() - 0.5f, u() - 0.5f));
+        ray.tmax = r % 2 ? kInfinity : 5.f + 10.f * u();
+        // Reference: every shape in index order, the nearest wins.
+        Ray ref_ray = ray;
+        Hit ref;
+        bool ref_found = false;
+        for (uint32_t i = 0; i < shapes.size(); ++i)
+            if (intersect_analytic(shapes[i], ref_ray, ref)) {
+                ref.prim = i;
+                ref_found = true;
+            }
+        bool ref_blocked = false;
+        for (const AnalyticShape& s : shapes) ref_blocked = ref_blocked || occluded_analytic(s, ray);
+        Ray bvh_ray = ray;
+        Hit h;
+        const bool found = accel.intersect(bvh_ray, h);
+        ASSERT_EQ(found, ref_found) << r;
+        ASSERT_EQ(accel.occluded(ray), ref_blocked) << r;
+        if (found) {
+            ASSERT_EQ(h.t, ref.t) << r;
+            ASSERT_EQ(h.prim, ref.prim) << r;
+            ++hits;
+        }
+        blocked += ref_blocked;
+    }
+    // Both outcomes occur often enough for the comparison to mean something.
+    EXPECT_GT(hits, 400);
+    EXPECT_LT(hits, 3600);
+    EXPECT_GT(blocked, 400);
 }

@@ -159,7 +159,7 @@ TEST(BadInput, UnsupportedFeatures) {
     std::string d = temp_dir("bad-unsupported");
     write_text(d + "/inc.xml", xml("\n<include filename=\"other.xml\"/>\n"));
     expect_clean_error(render(d + "/inc.xml", d), {d + "/inc.xml:3: ", "include"});
-    write_text(d + "/aov.xml", xml("<integrator type=\"aov\">\n<string name=\"aovs\" value=\"u:uv\"/>"
+    write_text(d + "/aov.xml", xml("<integrator type=\"aov\">\n<string name=\"aovs\" value=\"u:duv_dx\"/>"
                                    "<integrator type=\"path\"/></integrator>\n"));
     expect_clean_error(render(d + "/aov.xml", d), {d + "/aov.xml:3: ", "not supported"});
     write_text(d + "/nurbs.obj", "v 0 0 0\ncstype bspline\n");

@@ -290,6 +290,45 @@ TEST(IntegratorWrappers, AovLayersInTheExr) {
     EXPECT_NE(ck.output.find("checkpoints do not hold the aov integrator's layers"), std::string::npos) << ck.output;
 }
 
+// The moment wrapper's channels (Mitsuba's moment.cpp: the nested integrator's radiance as XYZ and
+// its per-sample square) and the uv / prim_index AOVs.
+TEST(IntegratorWrappers, MomentAndUvChannels) {
+    std::string d = test::temp_dir("moment-uv");
+    const std::string scene = cbox_with_integrator(
+        d, "<integrator type=\"moment\"><integrator type=\"aov\"><string name=\"aovs\" value=\"uu:uv,ii:prim_index,"
+           "du:dp_du\"/><integrator type=\"path\" name=\"img\"/></integrator></integrator>");
+    auto r = test::run_candela(scene + " -D res=16 -D filter=box --frames 64 --seed 5 --quiet --threads 2 --out " + d +
+                               "/m.exr");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    int w = 0, h = 0;
+    auto ch = read_exr_channels(d + "/m.exr", &w, &h);
+    ASSERT_EQ(w, 16);
+    for (const char* n : {"R", "G", "B", "uu.U", "uu.V", "ii.I", "du.X", "du.Y", "du.Z", "_arg_0.X", "_arg_0.Y",
+                          "_arg_0.Z", "m2__arg_0.X", "m2__arg_0.Y", "m2__arg_0.Z"})
+        ASSERT_TRUE(ch.count(n)) << "channel " << n;
+    EXPECT_EQ(ch.size(), 15u);
+    size_t spread = 0;
+    for (size_t i = 0; i < size_t(w * h); ++i) {
+        const float R = ch["R"][i], G = ch["G"][i], B = ch["B"][i];
+        // The first moment is the image itself in XYZ (a linear map commutes with the mean).
+        const float Y = 0.212671f * R + 0.715160f * G + 0.072169f * B;
+        ASSERT_NEAR(ch["_arg_0.Y"][i], Y, 1e-5f * std::max(1.f, Y)) << i;
+        ASSERT_NEAR(ch["_arg_0.X"][i], 0.412453f * R + 0.357580f * G + 0.180423f * B, 1e-5f * std::max(1.f, Y)) << i;
+        // The mean of the squares is at least the square of the mean, and strictly more where the
+        // samples differ (the path-traced walls, not the black outside).
+        const float m2 = ch["m2__arg_0.Y"][i];
+        ASSERT_GE(m2, Y * Y * (1.f - 1e-5f)) << i;
+        if (m2 > Y * Y * 1.01f) ++spread;
+        // The Cornell box's OBJ meshes have no uvs: uv is the barycentric (b1, b2) of the triangle,
+        // averaged over the pixel, and prim_index a triangle number within the shape.
+        EXPECT_GE(ch["uu.U"][i], 0.f);
+        EXPECT_LE(ch["uu.U"][i] + ch["uu.V"][i], 1.f + 1e-5f);
+        EXPECT_GE(ch["ii.I"][i], 0.f);
+        EXPECT_LT(ch["ii.I"][i], 64.f);
+    }
+    EXPECT_GT(spread, size_t(w * h / 2));
+}
+
 TEST(IntegratorXml, ParametersAndErrors) {
     std::string d = test::temp_dir("integrator-xml");
     auto load = [&](const std::string& integrator) {
@@ -309,8 +348,11 @@ TEST(IntegratorXml, ParametersAndErrors) {
              "<integrator type=\"volpath\"><integer name=\"max_depth\" value=\"2\"/></integrator></integrator></integrator>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
     EXPECT_EQ(s.settings.max_depth, 1);
-    ASSERT_EQ(s.settings.integrator.aovs.size(), 1u);
-    EXPECT_EQ(aov_channel_names(s.settings.integrator.aovs)[0], "d.T");
+    // The moment channels come last, named after the (unnamed: "_arg_0") integrator it holds.
+    ASSERT_EQ(s.settings.integrator.aovs.size(), 2u);
+    EXPECT_EQ(aov_channel_names(s.settings.integrator.aovs),
+              (std::vector<std::string>{"d.T", "_arg_0.X", "_arg_0.Y", "_arg_0.Z", "m2__arg_0.X", "m2__arg_0.Y",
+                                        "m2__arg_0.Z"}));
 
     auto expect_error = [&](const std::string& integrator, const std::string& needle) {
         try {
@@ -328,8 +370,10 @@ TEST(IntegratorXml, ParametersAndErrors) {
                  "at least one");
     expect_error("<integrator type=\"direct\"><integer name=\"max_depth\" value=\"2\"/></integrator>", "max_depth");
     expect_error("<integrator type=\"moment\"/>", "needs a nested <integrator>");
-    expect_error("<integrator type=\"aov\"><string name=\"aovs\" value=\"u:uv\"/><integrator type=\"path\"/></integrator>",
-                 "AOV type 'uv' is not supported");
+    expect_error("<integrator type=\"aov\"><string name=\"aovs\" value=\"b:boundary_test\"/><integrator type=\"path\"/></integrator>",
+                 "AOV type 'boundary_test' is not supported");
+    expect_error("<integrator type=\"moment\"><integrator type=\"moment\"><integrator type=\"path\"/></integrator></integrator>",
+                 "inside another moment");
     expect_error("<integrator type=\"aov\"><string name=\"aovs\" value=\"depth\"/><integrator type=\"path\"/></integrator>",
                  "expected <name>:<type>");
     expect_error("<integrator type=\"aov\"><integrator type=\"path\"/></integrator>", "needs an 'aovs' string");

@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 #include "accel/accel.h"
+#include "accel/box_bvh.h"
 #include "geometry/instance.h"
 
 namespace candela {
@@ -34,22 +35,14 @@ public:
     // The base and group accelerators plus the top-level BVH (not the meshes).
     size_t memory_bytes() const override;
 
-    struct Node {
-        AABB box;
-        uint32_t index;  // leaf: first entry of order_; interior: the second child (the first is next)
-        uint32_t count;  // instances in a leaf, 0 for an interior node
-    };
-
 private:
-    template <bool Shadow>
-    bool trace(Ray& ray, Hit* hit) const;
-    uint32_t build(uint32_t begin, uint32_t end, int depth);
+    // The ray carried into instance `id`'s group space.
+    Ray to_group(const Ray& ray, uint32_t id) const;
 
     std::unique_ptr<Accel> base_;
     std::vector<std::unique_ptr<Accel>> group_accels_;
     const std::vector<Instance>* instances_;
-    std::vector<Node> nodes_;
-    std::vector<uint32_t> order_;  // instance indices, leaf by leaf
+    BoxBvh bvh_;  // over the instances' world boxes
 };
 
 }  // namespace candela

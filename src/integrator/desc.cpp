@@ -2,7 +2,16 @@
 
 namespace candela {
 
-int aov_channel_count(AovType t) { return t == AovType::Depth ? 1 : 3; }
+int aov_channel_count(AovType t) {
+    switch (t) {
+        case AovType::Depth:
+        case AovType::PrimIndex:
+        case AovType::ShapeIndex: return 1;
+        case AovType::Uv: return 2;
+        case AovType::Moment: return 6;
+        default: return 3;
+    }
+}
 
 int aov_channel_count(const std::vector<AovSpec>& aovs) {
     int n = 0;
@@ -13,10 +22,23 @@ int aov_channel_count(const std::vector<AovSpec>& aovs) {
 std::vector<std::string> aov_channel_names(const std::vector<AovSpec>& aovs) {
     std::vector<std::string> names;
     for (const AovSpec& a : aovs) {
-        // Mitsuba's aov.cpp suffixes.
+        // Mitsuba's aov.cpp and moment.cpp suffixes.
+        if (a.type == AovType::Moment) {
+            for (const char* c : {".X", ".Y", ".Z"}) names.push_back(a.name + c);
+            for (const char* c : {".X", ".Y", ".Z"}) names.push_back("m2_" + a.name + c);
+            continue;
+        }
         const char* const* sfx;
-        static const char* const t[] = {".T"}, *xyz[] = {".X", ".Y", ".Z"}, *rgb[] = {".R", ".G", ".B"};
-        sfx = a.type == AovType::Depth ? t : a.type == AovType::Albedo ? rgb : xyz;
+        static const char* const t[] = {".T"}, *i[] = {".I"}, *uv[] = {".U", ".V"}, *xyz[] = {".X", ".Y", ".Z"},
+                                 *rgb[] = {".R", ".G", ".B"};
+        switch (a.type) {
+            case AovType::Depth: sfx = t; break;
+            case AovType::PrimIndex:
+            case AovType::ShapeIndex: sfx = i; break;
+            case AovType::Uv: sfx = uv; break;
+            case AovType::Albedo: sfx = rgb; break;
+            default: sfx = xyz; break;
+        }
         for (int k = 0; k < aov_channel_count(a.type); ++k) names.push_back(a.name + sfx[k]);
     }
     return names;
@@ -28,6 +50,11 @@ bool parse_aov_type(const std::string& s, AovType& out) {
     else if (s == "geo_normal") out = AovType::GeoNormal;
     else if (s == "sh_normal") out = AovType::ShNormal;
     else if (s == "albedo") out = AovType::Albedo;
+    else if (s == "uv") out = AovType::Uv;
+    else if (s == "dp_du") out = AovType::DpDu;
+    else if (s == "dp_dv") out = AovType::DpDv;
+    else if (s == "prim_index") out = AovType::PrimIndex;
+    else if (s == "shape_index") out = AovType::ShapeIndex;
     else return false;
     return true;
 }

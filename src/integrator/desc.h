@@ -20,6 +20,15 @@ enum class AovType {
     GeoNormal,  // geometric normal (world, unit, the triangle's winding side): ".X" ".Y" ".Z"
     ShNormal,   // shading normal (world, unit, interpolated where the mesh has normals): ".X" ".Y" ".Z"
     Albedo,     // the BSDF's diffuse reflectance, Mitsuba's eval_diffuse_reflectance: ".R" ".G" ".B"
+    Uv,         // texture coordinates of the hit (the shape's parameterisation): ".U" ".V"
+    DpDu,       // world-space dp/du at the hit (SurfaceInteraction::dpdu): ".X" ".Y" ".Z"
+    DpDv,       // world-space dp/dv: ".X" ".Y" ".Z"
+    PrimIndex,  // the triangle's index within its shape (0 on analytic shapes), as a float: ".I"
+    ShapeIndex, // candela's shape index (Mitsuba writes an id of its own, not comparable): ".I"
+    // Not an aov type: the `moment` wrapper's channels, always last. The nested integrator's
+    // radiance per sample as CIE XYZ, then its square (the per-sample second moment), both filtered
+    // like the image: "<name>.X" ".Y" ".Z" "m2_<name>.X" ".Y" ".Z" (Mitsuba's moment.cpp).
+    Moment,
 };
 
 struct AovSpec {

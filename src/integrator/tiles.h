@@ -13,7 +13,8 @@
 // one sample index at a time (all tiles for index s, merge, then s + 1), so the additions into a
 // pixel happen in the order (sample index, tile, pixel), whatever the thread count and whatever
 // the split of the samples into passes: the image is the same bit for bit.
-// AOVs (the aov wrapper): computed for the camera ray before `li` runs, filtered the same way.
+// AOVs (the aov wrapper): computed for the camera ray before `li` runs, filtered the same way;
+// the moment wrapper's channels from the sample's radiance after it.
 #include <omp.h>
 #include <algorithm>
 #include <cmath>
@@ -84,6 +85,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
     camera.set_film_size(w, h);
     const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
     const int n_aov = film.aov_channels();
+    const int moment_at = moment_offset(aovs);
     const vec3 eye = camera.origin();
     const bool alpha = film.has_alpha();
     std::atomic<uint64_t> total_rays{0}, total_samples{0};
@@ -119,6 +121,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                         const uint64_t hits = ps.camera_hits;
                         vec3 L = li(sampler, ray, ps);
                         film.add_sample(ivec2(x, y), L);
+                        if (moment_at >= 0) write_moment(aov + moment_at, all_finite(L) ? L : vec3(0.f));
                         if (alpha) film.add_coverage(ivec2(x, y), ps.camera_hits != hits);
                         if (n_aov > 0) film.add_aov(ivec2(x, y), aov);
                         ++samples;
@@ -159,6 +162,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                             L = vec3(0.f);
                         }
                         film.count_sample(ivec2(x, y));
+                        if (moment_at >= 0) write_moment(aov + moment_at, L);
                         detail::splat(ft, filter, w, h, pos, L, aov, ps.camera_hits != hits);
                         ++samples;
                     }

@@ -40,6 +40,25 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
             case AovType::ShNormal:
                 for (int k = 0; k < 3; ++k) *o++ = si.ns[k];
                 break;
+            case AovType::Uv:
+                *o++ = si.uv.x;
+                *o++ = si.uv.y;
+                break;
+            case AovType::DpDu:
+                for (int k = 0; k < 3; ++k) *o++ = si.dpdu[k];
+                break;
+            case AovType::DpDv:
+                for (int k = 0; k < 3; ++k) *o++ = si.dpdv[k];
+                break;
+            case AovType::PrimIndex: {
+                // Mitsuba's prim_index: the triangle within its mesh; an analytic shape is one primitive.
+                // (A group's shape counts its first_triangle in the group's mesh, as hit.prim does.)
+                const Shape& shape = scene.shapes[si.shape];
+                *o++ = hit.kind == PrimKind::Triangle ? float(hit.prim - shape.first_triangle) : 0.f;
+                break;
+            }
+            case AovType::ShapeIndex: *o++ = float(si.shape); break;
+            case AovType::Moment: o += aov_channel_count(AovType::Moment); break;  // write_moment's
             case AovType::Albedo: {
                 const Material& mat = scene.materials[scene.shapes[si.shape].material];
                 vec3 n = si.ns;

@@ -43,13 +43,13 @@ std::vector<AovSpec> parse_aovs(const ParamSet& p) {
         a.name = item.substr(0, colon);
         const std::string type = item.substr(colon + 1);
         if (!parse_aov_type(type, a.type)) {
-            const bool mitsuba = type == "uv" || type == "dp_du" || type == "dp_dv" || type == "duv_dx" ||
-                                 type == "duv_dy" || type == "prim_index" || type == "shape_index" ||
-                                 type == "boundary_test";
+            const bool mitsuba = type == "duv_dx" || type == "duv_dy" || type == "boundary_test";
             throw p.error("aovs", "AOV type '" + type + "' " +
-                                      (mitsuba ? "is not supported (candela's surfaces carry no uv parameterisation yet)"
+                                      (mitsuba ? "is not supported (candela traces no ray differentials and no "
+                                                 "boundary test)"
                                                : "is unknown") +
-                                      "; candela writes depth, position, sh_normal, geo_normal, albedo");
+                                      "; candela writes depth, position, uv, sh_normal, geo_normal, dp_du, dp_dv, "
+                                      "albedo, prim_index, shape_index");
         }
         out.push_back(a);
     }
@@ -88,8 +88,8 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Renders;
     }
     if (type == "moment") {
-        // The image is the nested integrator's; Mitsuba adds its second moment as extra AOV
-        // channels, which candela does not write.
+        // The image is the nested integrator's; the caller, which knows the nested integrator's
+        // name, adds the moment channels (AovType::Moment) once the nesting is read.
         p.report_unused();
         return IntegratorRole::Wraps;
     }
