@@ -21,11 +21,14 @@ struct TexturableParam {
 
 // The textures nested in a BSDF, each bound to the parameter it names; a texture for a parameter
 // that candela does not texture (e.g. a roughness) is an error, not a silent constant.
+std::shared_ptr<const Texture> as_float_texture(std::shared_ptr<const Texture> t);  // below
+
 Material with_textures(XmlLoader& L, Object& o, Material m, std::initializer_list<TexturableParam> params) {
     for (const TexturableParam& p : params)
         if (auto t = nested_texture(L, o, p.name)) {
             if (o.params.has(p.name)) throw o.params.error(p.name, std::string("'") + p.name + "' is given both as a value and as a texture");
-            m.textures.push_back(TextureSlot{t, p.apply, p.name});
+            const bool scalar = std::string(p.name).rfind("alpha", 0) == 0;  // a float parameter
+            m.textures.push_back(TextureSlot{scalar ? as_float_texture(t) : t, p.apply, p.name});
         }
     for (const Nested& c : o.nested)
         if (!c.used && c.tag == "texture")
@@ -111,6 +114,21 @@ MicrofacetParams microfacet_params(XmlLoader& L, Object& o, bool anisotropic_all
         mp.alpha_u = mp.alpha_v = checked("alpha", 0.1f);
     }
     return mp;
+}
+
+// Mitsuba reads a checkerboard as a float (eval_1) with its colours the other way round from the
+// colour reading (eval: color0 where both fractional parts are on the same side of 1/2; eval_1:
+// where they differ; measured in 3.9.1 too). A float parameter driven by a checkerboard gets a
+// copy with the colours swapped, so it agrees with Mitsuba (nested checkerboards inside its
+// colours are kept as they are).
+std::shared_ptr<const Texture> as_float_texture(std::shared_ptr<const Texture> t) {
+    if (std::holds_alternative<CheckerboardTexture>(t->v)) {
+        auto swapped = std::make_shared<Texture>(*t);
+        auto& sc = std::get<CheckerboardTexture>(swapped->v);
+        std::swap(sc.color0, sc.color1);
+        return swapped;
+    }
+    return t;
 }
 
 // Texture slots for the roughness of a conductor or dielectric (both have alpha_u, alpha_v).
