@@ -58,7 +58,8 @@ TEST(BsdfWeights, RoughDielectricWeightIsAtMostOne) {
             DielectricBsdf d;
             d.int_ior = ior;
             d.ext_ior = 1.f;
-            d.alpha = a;
+            d.distribution = MicrofacetType::GGX;
+            d.alpha_u = d.alpha_v = a;
             const Bsdf b = d;
             float row_max = 0.f;
             for (float side : {1.f, -1.f})

@@ -466,8 +466,8 @@ TEST(SceneXml, MaterialPluginsMapTheirParameters) {
     expect_near(c.eta, vec3(0.2f, 0.4f, 1.4f));
     expect_near(c.k, vec3(3.9f, 2.4f, 1.8f));
     expect_near(c.specular_reflectance, vec3(0.9f));
-    EXPECT_EQ(c.alpha, 0.f);  // conductor: the ideal mirror
-    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(1)).alpha, 0.25f);
+    EXPECT_EQ(c.alpha_u, 0.f);  // conductor: the ideal mirror
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(1)).alpha_u, 0.25f);
 
     const auto& p = std::get<PlasticBsdf>(bsdf(2));
     expect_near(p.diffuse_reflectance, vec3(0.1f, 0.2f, 0.3f));
@@ -484,15 +484,15 @@ TEST(SceneXml, MaterialPluginsMapTheirParameters) {
     const auto& d = std::get<DielectricBsdf>(bsdf(4));
     EXPECT_NEAR(d.int_ior, 2.419f, 1e-3f);  // Mitsuba's "diamond"
     EXPECT_FLOAT_EQ(d.ext_ior, 1.000277f);
-    EXPECT_EQ(d.alpha, 0.f);
+    EXPECT_EQ(d.alpha_u, 0.f);
     const auto& rd = std::get<DielectricBsdf>(bsdf(5));
-    EXPECT_FLOAT_EQ(rd.alpha, 0.05f);
+    EXPECT_FLOAT_EQ(rd.alpha_u, 0.05f);
     EXPECT_FLOAT_EQ(rd.eta(), 1.33f / 1.1f);
     expect_near(rd.specular_transmittance, vec3(0.5f));
     expect_near(rd.specular_reflectance, vec3(1.f));
 
     EXPECT_TRUE(s.materials[s.shapes[6].material].two_sided);
-    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(6)).alpha, 0.1f);
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(bsdf(6)).alpha_u, 0.1f);
     for (int i = 0; i < 6; ++i) EXPECT_FALSE(s.materials[s.shapes[size_t(i)].material].two_sided) << i;
     const auto& c0 = std::get<ConductorBsdf>(bsdf(7));  // defaults: eta 0, k 1
     expect_near(c0.eta, vec3(0.f));
@@ -524,7 +524,7 @@ TEST(SceneXml, EveryShippedSceneLoads) {
     SceneDescription v = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/scenes/veach-mis/scene.xml", {});
     std::vector<float> alphas;
     for (const Material& m : v.materials)
-        if (auto* k = std::get_if<ConductorBsdf>(&m.bsdf)) alphas.push_back(k->alpha);
+        if (auto* k = std::get_if<ConductorBsdf>(&m.bsdf)) alphas.push_back(k->alpha_u);
     std::sort(alphas.begin(), alphas.end());
     ASSERT_EQ(alphas.size(), 4u);
     EXPECT_FLOAT_EQ(alphas[0], 0.01f);

@@ -176,7 +176,8 @@ std::vector<NamedBsdf> extreme_bsdfs() {
     v.push_back({"diffuse", DiffuseBsdf{vec3(0.7f)}});
     for (float a : {0.f, 1e-4f, 1.f}) {
         ConductorBsdf c;
-        c.alpha = a;
+        c.distribution = MicrofacetType::GGX;
+        c.alpha_u = c.alpha_v = a;
         v.push_back({"mirror/conductor a=" + std::to_string(a), c});
         c.eta = vec3(0.2f, 0.9f, 1.1f);  // gold-like complex IOR
         c.k = vec3(3.9f, 2.4f, 2.2f);
@@ -187,7 +188,8 @@ std::vector<NamedBsdf> extreme_bsdfs() {
             DielectricBsdf d;
             d.int_ior = ior;
             d.ext_ior = 1.f;
-            d.alpha = a;
+            d.distribution = MicrofacetType::GGX;
+            d.alpha_u = d.alpha_v = a;
             v.push_back({"dielectric ior=" + std::to_string(ior) + " a=" + std::to_string(a), d});
             PlasticBsdf p;
             p.int_ior = ior;
@@ -258,7 +260,8 @@ TEST(Stability, TotalInternalReflectionKeepsAllEnergy) {
             DielectricBsdf d;
             d.int_ior = ior;
             d.ext_ior = 1.f;
-            d.alpha = a;
+            d.distribution = MicrofacetType::GGX;
+            d.alpha_u = d.alpha_v = a;
             // Inside (wo.z < 0), sin theta_o = 0.95 > 1 / ior.
             RunningStats w;
             int refracted = 0;

@@ -21,17 +21,19 @@
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
 #include "bsdf/plastic.h"
+#include "bsdf/thindielectric.h"
 #include "texture/texture.h"
 
 namespace candela {
 
 // Each alternative is a plain struct of parameters (the viewer edits them in place):
 //   DiffuseBsdf     Lambertian                                   (Mitsuba `diffuse`)
-//   ConductorBsdf   mirror (alpha 0) or GGX metal                (`conductor`, `roughconductor`)
+//   ConductorBsdf   mirror (alpha 0) or rough metal               (`conductor`, `roughconductor`)
 //   PlasticBsdf     dielectric coat over a diffuse base          (`plastic`, `roughplastic`)
-//   DielectricBsdf  glass, smooth (alpha 0) or GGX rough         (`dielectric`, `roughdielectric`)
+//   DielectricBsdf  glass, smooth (alpha 0) or rough             (`dielectric`, `roughdielectric`)
+//   ThinDielectricBsdf  a thin pane: reflection + straight through (`thindielectric`)
 // docs/materials.md describes each model and its tests.
-using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf>;
+using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf>;
 
 // Dispatch that knows only the diffuse BSDF, as a diffuse-only renderer would have it; any other
 // BSDF renders black. Used in two places: the whole dispatch of the yardstick build for issue 6

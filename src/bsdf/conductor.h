@@ -9,7 +9,9 @@ namespace candela {
 // A metal: specular reflection weighted by the conductor Fresnel term, smooth or rough.
 //   alpha == 0   ideal mirror, a delta lobe (Mitsuba 3 `conductor`): sample() returns the mirror
 //                direction with pdf 1 and f = specular_reflectance * F(cos theta_o); eval = pdf = 0.
-//   alpha > 0    GGX microfacet reflection (Walter et al. 2007; Mitsuba 3 `roughconductor`):
+//   alpha > 0    microfacet reflection (Walter et al. 2007; Mitsuba 3 `roughconductor`), with
+//                the Beckmann or GGX distribution D of microfacet.h, anisotropic (alpha_u along
+//                the tangent x, alpha_v along y):
 //                f(wo, wi) cos theta_i = R F(wo.h) D(h) G1(wo, h) G1(wi, h) / (4 cos theta_o),
 //                h = normalize(wo + wi); sampled from the normals visible from wo, so
 //                pdf = D_wo(h) / (4 wo.h) and the weight is R F G1(wi, h).
@@ -20,9 +22,11 @@ struct ConductorBsdf {
     vec3 eta{0.f};                   // complex IOR of the metal relative to the outside medium
     vec3 k{1.f};
     vec3 specular_reflectance{1.f};  // tint R (not physical, but handy)
-    float alpha = 0.f;               // GGX roughness; 0 = ideal mirror
+    MicrofacetType distribution = MicrofacetType::Beckmann;  // Mitsuba's default
+    float alpha_u = 0.f, alpha_v = 0.f;  // roughness along x and y; both 0 = ideal mirror
 
-    bool is_delta() const { return !(alpha > 0.f); }
+    bool is_delta() const { return !(std::max(alpha_u, alpha_v) > 0.f); }
+    Microfacet microfacet() const { return Microfacet(distribution, alpha_u, alpha_v); }
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode) const {
         if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return vec3(0.f);
@@ -42,8 +46,7 @@ struct ConductorBsdf {
             s.f = specular_reflectance * fresnel_conductor(wo.z, eta, k);
             return s;
         }
-        const Ggx ggx(alpha);
-        const vec3 m = ggx.sample_visible(wo, u);
+        const vec3 m = microfacet().sample_visible(wo, u);
         s.wi = reflect(wo, m);
         if (s.wi.z <= 0.f) return std::nullopt;  // reflected below the surface: no sample
         auto [f, p] = eval_pdf(wo, s.wi);
@@ -58,7 +61,7 @@ private:
     // Both from the same half vector, so that f / pdf is exactly R F G1(wi, h).
     std::pair<vec3, float> eval_pdf(vec3 wo, vec3 wi) const {
         const vec3 h = glm::normalize(wo + wi);
-        const Ggx ggx(alpha);
+        const Microfacet ggx = microfacet();
         const float D = ggx.D(h);
         const float g1o = ggx.G1(wo, h), g1i = ggx.G1(wi, h);
         if (D == 0.f || g1o == 0.f || g1i == 0.f) return {vec3(0.f), 0.f};

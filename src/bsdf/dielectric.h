@@ -15,7 +15,8 @@ namespace candela {
 //               probability F (exact Fresnel, total internal reflection included) with
 //               f = R_s F, and refracts otherwise with f = T_s (1 - F) * (1 / eta_r^2 in Radiance
 //               mode): the weight f / pdf is R_s or T_s / eta_r^2. eval = pdf = 0.
-//   alpha > 0   rough (Walter et al. 2007, GGX; Mitsuba 3 `roughdielectric`), with the
+//   alpha > 0   rough (Walter et al. 2007; Mitsuba 3 `roughdielectric`; Beckmann or GGX,
+//               anisotropic alpha_u / alpha_v as in microfacet.h), with the
 //               generalised half vector h = +-normalize(wo + eta_r wi), h.z > 0:
 //                 reflection   f |cos theta_i| = R_s F D G / (4 |cos theta_o|)
 //                 refraction   f |cos theta_i| = T_s (1 - F) D G eta_r^2 |wo.h| |wi.h|
@@ -37,10 +38,12 @@ struct DielectricBsdf {
     float ext_ior = 1.000277f; // air
     vec3 specular_reflectance{1.f};
     vec3 specular_transmittance{1.f};
-    float alpha = 0.f;         // GGX roughness; 0 = smooth
+    MicrofacetType distribution = MicrofacetType::Beckmann;  // Mitsuba's default
+    float alpha_u = 0.f, alpha_v = 0.f;  // roughness along x and y; both 0 = smooth
 
     float eta() const { return int_ior / ext_ior; }
-    bool is_delta() const { return !(alpha > 0.f); }
+    bool is_delta() const { return !(std::max(alpha_u, alpha_v) > 0.f); }
+    Microfacet microfacet() const { return Microfacet(distribution, alpha_u, alpha_v); }
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode mode) const {
         if (is_delta()) return vec3(0.f);
@@ -73,7 +76,7 @@ struct DielectricBsdf {
         }
         // m from the normals visible from wo; from inside (wo.z < 0) from those visible from the
         // mirrored wo, as Mitsuba 3 does, so that m is on the upper side like eval_pdf's h.
-        const Ggx ggx(alpha);
+        const Microfacet ggx = microfacet();
         const float side = wo.z > 0.f ? 1.f : -1.f;
         const vec3 m = ggx.sample_visible(wo * side, u2);
         const float om = glm::dot(wo, m);
@@ -124,7 +127,7 @@ private:
         const float oh = glm::dot(wo, h), ih = glm::dot(wi, h);
         // Each direction must see the microfacet from its own side of the macro-surface.
         if (oh * co <= 0.f || ih * ci <= 0.f) return r;
-        const Ggx ggx(alpha);
+        const Microfacet ggx = microfacet();
         const float D = ggx.D(h);
         const float G = ggx.G1(wo, h) * ggx.G1(wi, h);
         const float F = fresnel_dielectric(oh, e).F;

@@ -1,6 +1,7 @@
 #include "bsdf/plastic.h"
 #include <map>
 #include <mutex>
+#include <tuple>
 #include "sampling/warp.h"
 
 namespace candela {
@@ -52,7 +53,7 @@ namespace {
 // relative IOR across is eta: the part reflected (transmitted = false) or transmitted, counting
 // single scattering only. With visible-normal sampling of h the estimator of one lobe is
 // F G1(reflected) or (1 - F) G1(refracted), integrated over the unit square by the midpoint rule.
-double rough_interface_albedo(const Ggx& ggx, vec3 w, float eta, bool transmitted) {
+double rough_interface_albedo(const Microfacet& ggx, vec3 w, float eta, bool transmitted) {
     const int n = 64;
     double sum = 0.0;
     for (int j = 0; j < n; ++j)
@@ -71,17 +72,18 @@ double rough_interface_albedo(const Ggx& ggx, vec3 w, float eta, bool transmitte
     return sum / (double(n) * n);
 }
 
-std::shared_ptr<const CoatTables> compute_tables(float alpha, float eta) {
+std::shared_ptr<const CoatTables> compute_tables(float alpha, float eta, MicrofacetType dist) {
     auto t = std::make_shared<CoatTables>();
     t->alpha = alpha;
     t->eta = eta;
+    t->distribution = dist;
     const int R = CoatTables::kRes;
     if (alpha == 0.f) {
         for (int i = 0; i < R; ++i) t->transmittance[size_t(i)] = 1.f - fresnel_dielectric(float(i) / (R - 1), eta).F;
         t->internal_reflectance = fresnel_diffuse_reflectance(1.f / eta);
         return t;
     }
-    const Ggx ggx(alpha);
+    const Microfacet ggx(dist, alpha);
     double internal = 0.0;
     for (int i = 0; i < R; ++i) {
         // Mitsuba's grid: mu = i / (R - 1), kept off exactly grazing.
@@ -100,11 +102,11 @@ std::shared_ptr<const CoatTables> compute_tables(float alpha, float eta) {
 namespace {
 
 // Scenes often share one coat among many objects, and the viewer's scenes share it between the
-// versions an edit makes: tables are shared by (alpha, eta). The cache holds them weakly, so a
+// versions an edit makes: tables are shared by (alpha, eta, distribution; smooth coats by eta). The cache holds them weakly, so a
 // table lives as long as some material uses it; a roughness slider dragged through a thousand
 // values leaves only the tables still in use (expired entries are dropped on every insertion).
 std::mutex coat_cache_mutex;
-std::map<std::pair<float, float>, std::weak_ptr<const CoatTables>> coat_cache;
+std::map<std::tuple<float, float, MicrofacetType>, std::weak_ptr<const CoatTables>> coat_cache;
 
 }  // namespace
 
@@ -116,12 +118,14 @@ size_t coat_table_cache_size() {
 void PlasticBsdf::prepare() {
     if (prepared()) return;
     const float a = smooth() ? 0.f : alpha;
+    // A smooth coat does not depend on the distribution: one key for it.
+    const MicrofacetType d = smooth() ? MicrofacetType::Beckmann : distribution;
     std::lock_guard<std::mutex> lock(coat_cache_mutex);
-    std::weak_ptr<const CoatTables>& slot = coat_cache[{a, eta()}];
+    std::weak_ptr<const CoatTables>& slot = coat_cache[{a, eta(), d}];
     std::shared_ptr<const CoatTables> t = slot.lock();
     if (!t) {
         // Computed under the lock: two threads preparing the same coat compute it once.
-        t = compute_tables(a, eta());
+        t = compute_tables(a, eta(), d);
         slot = t;
         for (auto it = coat_cache.begin(); it != coat_cache.end();)
             it = it->second.expired() ? coat_cache.erase(it) : std::next(it);
@@ -157,7 +161,7 @@ vec3 PlasticBsdf::diffuse_value(vec3 wo, vec3 wi) const {
 }
 
 PlasticBsdf::Lobe PlasticBsdf::coat(vec3 wo, vec3 wi, vec3 m) const {
-    const Ggx ggx(alpha);
+    const Microfacet ggx(distribution, alpha);
     const float g1o = ggx.G1(wo, m), g1i = ggx.G1(wi, m);
     if (g1o == 0.f || g1i == 0.f) return {};
     // pdf = D_wo(m) / (4 wo.m) = G1(wo, m) D(m) / (4 cos theta_o): the Jacobian of reflection,
@@ -197,7 +201,7 @@ std::optional<BsdfSample> PlasticBsdf::sample(vec3 wo, float u1, vec2 u2, Transp
     if (u1 < ps) {
         // The coat's part from the sampled normal m itself: near grazing, the half vector that
         // eval() rebuilds from wo + wi (nearly cancelling) can be far from m.
-        const vec3 m = Ggx(alpha).sample_visible(wo, u2);
+        const vec3 m = Microfacet(distribution, alpha).sample_visible(wo, u2);
         s.wi = reflect(wo, m);
         if (s.wi.z <= 0.f) return std::nullopt;
         const Lobe c = coat(wo, s.wi, m);

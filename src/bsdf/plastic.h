@@ -9,12 +9,13 @@
 namespace candela {
 
 // What a plastic coat needs beyond its parameters; computed by prepare() (plastic.cpp) for one
-// (alpha, eta) pair.
+// (alpha, eta, distribution).
 struct CoatTables {
     static constexpr int kRes = 64;
     float alpha = -1.f, eta = 0.f;  // what the tables were computed for
+    MicrofacetType distribution = MicrofacetType::Beckmann;
     // Transmittance of the coat for light arriving from outside, against cos theta on a uniform
-    // grid over [0, 1] (smooth coat: 1 - F; rough: integral of the GGX dielectric transmission).
+    // grid over [0, 1] (smooth coat: 1 - F; rough: integral of the rough dielectric transmission).
     std::array<float, kRes> transmittance{};
     // Fraction of the base's diffuse light that the coat reflects back down.
     float internal_reflectance = 0.f;
@@ -29,7 +30,7 @@ size_t coat_table_cache_size();
 // false by default). eta = int_ior / ext_ior. With T(mu) the coat's transmittance, Ri its internal
 // reflectance and rho = diffuse_reflectance:
 //   specular  alpha == 0: a delta mirror lobe with weight R_s F(cos theta_o), eval/pdf exclude it.
-//             alpha > 0:  GGX reflection R_s F(wo.h) D G / (4 cos theta_o) (as the rough conductor),
+//             alpha > 0:  microfacet (Beckmann or GGX) reflection R_s F(wo.h) D G / (4 cos theta_o) (as the rough conductor),
 //                         h sampled from the visible normals: lobe weight R_s F(wo.h) G1(wi, h) <= 1
 //   diffuse   f cos theta_i = rho / (1 - Ri) * T(cos theta_o) T(cos theta_i) cos theta_i / (pi eta^2)
 //             (nonlinear: rho / (1 - rho Ri), the colour shift of repeated internal bounces)
@@ -44,13 +45,17 @@ struct PlasticBsdf {
     vec3 specular_reflectance{1.f};
     float int_ior = 1.49f;      // polypropylene
     float ext_ior = 1.000277f;  // air
-    float alpha = 0.f;          // GGX roughness of the coat; 0 = smooth
+    float alpha = 0.f;          // roughness of the coat (isotropic, as Mitsuba); 0 = smooth
+    MicrofacetType distribution = MicrofacetType::Beckmann;  // Mitsuba's default
     bool nonlinear = false;
     std::shared_ptr<const CoatTables> tables;  // derived data, see prepare()
 
     float eta() const { return int_ior / ext_ior; }
     bool smooth() const { return !(alpha > 0.f); }
-    bool prepared() const { return tables && tables->alpha == (smooth() ? 0.f : alpha) && tables->eta == eta(); }
+    bool prepared() const {
+        return tables && tables->alpha == (smooth() ? 0.f : alpha) && tables->eta == eta() &&
+               (smooth() || tables->distribution == distribution);
+    }
     // (Re)computes the tables when alpha or the IORs changed since the last call.
     void prepare();
 

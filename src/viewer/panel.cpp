@@ -36,6 +36,9 @@ CANDELA_HAS_MEMBER(k)
 CANDELA_HAS_MEMBER(int_ior)
 CANDELA_HAS_MEMBER(ext_ior)
 CANDELA_HAS_MEMBER(alpha)
+CANDELA_HAS_MEMBER(alpha_u)
+CANDELA_HAS_MEMBER(alpha_v)
+CANDELA_HAS_MEMBER(distribution)
 CANDELA_HAS_MEMBER(nonlinear)
 #undef CANDELA_HAS_MEMBER
 
@@ -61,8 +64,21 @@ bool edit_bsdf(T& b) {
     if constexpr (has_k<T, vec3>::value) any = true, changed |= drag_positive("k", b.k, 0.01f);
     if constexpr (has_int_ior<T, float>::value) any = true, changed |= ior("interior IOR", b.int_ior);
     if constexpr (has_ext_ior<T, float>::value) any = true, changed |= ior("exterior IOR", b.ext_ior);
+    if constexpr (has_distribution<T, MicrofacetType>::value) {
+        // Beckmann / GGX; index = the enum's value.
+        int d = int(b.distribution);
+        const char* names[] = {"beckmann", "ggx"};
+        any = true;
+        if (ImGui::Combo("distribution", &d, names, 2)) b.distribution = MicrofacetType(d), changed = true;
+    }
     if constexpr (has_alpha<T, float>::value)
         any = true, changed |= ImGui::SliderFloat("roughness", &b.alpha, 0.f, 1.f, "alpha %.3f");
+    if constexpr (has_alpha_u<T, float>::value && has_alpha_v<T, float>::value) {
+        // Both 0 is the smooth (delta) model; one slider each, as Mitsuba's alpha_u / alpha_v.
+        any = true;
+        changed |= ImGui::SliderFloat("roughness u", &b.alpha_u, 0.f, 1.f, "alpha_u %.3f");
+        changed |= ImGui::SliderFloat("roughness v", &b.alpha_v, 0.f, 1.f, "alpha_v %.3f");
+    }
     if constexpr (has_nonlinear<T, bool>::value)
         any = true, changed |= ImGui::Checkbox("nonlinear", &b.nonlinear);
     if (!any) ImGui::TextDisabled("(no editable parameters)");
@@ -76,7 +92,8 @@ template <class T>
 const char* model_name(const T&) {
     if constexpr (has_albedo<T, vec3>::value) return "diffuse";
     else if constexpr (has_diffuse_reflectance<T, vec3>::value) return "plastic";
-    else if constexpr (has_specular_transmittance<T, vec3>::value) return "dielectric";
+    else if constexpr (has_specular_transmittance<T, vec3>::value)
+        return has_alpha_u<T, float>::value ? "dielectric" : "thindielectric";
     else if constexpr (has_k<T, vec3>::value) return "conductor";
     else return "bsdf";
 }

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include "bsdf/fresnel.h"
 #include "bsdf/microfacet.h"
+#include "bsdf/named_conductors.h"
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -20,11 +21,14 @@ struct TexturableParam {
 
 // The textures nested in a BSDF, each bound to the parameter it names; a texture for a parameter
 // that candela does not texture (e.g. a roughness) is an error, not a silent constant.
+std::shared_ptr<const Texture> as_float_texture(std::shared_ptr<const Texture> t);  // below
+
 Material with_textures(XmlLoader& L, Object& o, Material m, std::initializer_list<TexturableParam> params) {
     for (const TexturableParam& p : params)
         if (auto t = nested_texture(L, o, p.name)) {
             if (o.params.has(p.name)) throw o.params.error(p.name, std::string("'") + p.name + "' is given both as a value and as a texture");
-            m.textures.push_back(TextureSlot{t, p.apply, p.name});
+            const bool scalar = std::string(p.name).rfind("alpha", 0) == 0;  // a float parameter
+            m.textures.push_back(TextureSlot{scalar ? as_float_texture(t) : t, p.apply, p.name});
         }
     for (const Nested& c : o.nested)
         if (!c.used && c.tag == "texture")
@@ -40,8 +44,8 @@ Material make_diffuse(XmlLoader& L, Object& o) {
 }
 
 // ---- BSDFs of issue 5 (conductor, plastic, dielectric, twosided) -------------------------------
-// Mitsuba 3's parameter names and defaults; what candela does not model (textures, Beckmann,
-// anisotropy, named conductor spectra) is an error rather than a silent difference.
+// Mitsuba 3's parameter names and defaults; what candela does not model (e.g. sample_visible
+// false, a texture on the plastic's roughness) is an error rather than a silent difference.
 
 // An IOR given as a number or as one of Mitsuba's material names ("bk7", "air", "diamond"...).
 float ior_param(Object& o, const std::string& name, float def) {
@@ -65,34 +69,103 @@ vec3 nonnegative_rgb(Object& o, const std::string& name, vec3 def) {
     return v;
 }
 
-// GGX roughness: distribution must say ggx (Mitsuba's default is beckmann, which candela lacks).
-float microfacet_alpha(Object& o, float def) {
+// Microfacet roughness as Mitsuba's MicrofacetDistribution reads it: `distribution` beckmann (the
+// default) or ggx; `alpha`, or both `alpha_u` and `alpha_v` (anisotropic; not both forms). A
+// roughness may also be a nested texture (float value: the luminance of its colour, as Mitsuba's
+// eval_1); the constant then holds the default and bsdf_at overwrites it at each point.
+struct MicrofacetParams {
+    MicrofacetType type = MicrofacetType::Beckmann;
+    float alpha_u = 0.1f, alpha_v = 0.1f;
+};
+
+bool has_texture_named(const Object& o, const char* name, XmlLoader& L) {
+    for (const Nested& c : o.nested)
+        if (c.tag == "texture" && L.attr(c.node, "name") == name) return true;
+    return false;
+}
+
+MicrofacetParams microfacet_params(XmlLoader& L, Object& o, bool anisotropic_allowed) {
+    MicrofacetParams mp;
     std::string d = o.params.get_string("distribution", "beckmann");
-    if (d != "ggx")
-        throw o.params.error("distribution", "distribution '" + d + "' is not supported (only ggx" +
-                                                 std::string(o.params.has("distribution") ? "" : "; Mitsuba's default is beckmann") + ")");
-    if (o.params.has("alpha_u") || o.params.has("alpha_v"))
-        throw o.params.error(o.params.has("alpha_u") ? "alpha_u" : "alpha_v", "anisotropic roughness is not supported");
+    std::transform(d.begin(), d.end(), d.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (d == "ggx") mp.type = MicrofacetType::GGX;
+    else if (d != "beckmann") throw o.params.error("distribution", "distribution '" + d + "' is invalid: must be beckmann or ggx");
     if (!o.params.get_bool("sample_visible", true))
         throw o.params.error("sample_visible", "only visible-normal sampling is implemented");
-    float a = o.params.get_float("alpha", def);
-    if (!(a >= 0.f) || a > 4.f) throw o.params.error("alpha", "alpha must be in [0, 4]");
-    return std::max(a, kMinAlpha);  // Mitsuba clamps too; alpha 0 is the smooth plugin's job
+    const bool has_a = o.params.has("alpha") || has_texture_named(o, "alpha", L);
+    const bool has_u = o.params.has("alpha_u") || has_texture_named(o, "alpha_u", L);
+    const bool has_v = o.params.has("alpha_v") || has_texture_named(o, "alpha_v", L);
+    if (!anisotropic_allowed && (has_u || has_v)) {
+        const char* n = has_u ? "alpha_u" : "alpha_v";
+        if (o.params.has(n)) throw o.params.error(n, std::string(n) + ": " + o.what() + " is isotropic (give alpha)");
+        throw L.error(o.node, std::string("a texture for '") + n + "': " + o.what() + " is isotropic (give alpha)");
+    }
+    auto checked = [&](const char* name, float def) {
+        float a = o.params.get_float(name, def);
+        if (!(a >= 0.f) || a > 4.f) throw o.params.error(name, std::string(name) + " must be in [0, 4]");
+        return std::max(a, kMinAlpha);  // Mitsuba clamps too; alpha 0 is the smooth plugin's job
+    };
+    if (has_a && (has_u || has_v)) throw L.error(o.node, o.what() + ": give either alpha or alpha_u/alpha_v, not both");
+    if (has_u != has_v) throw L.error(o.node, o.what() + ": both alpha_u and alpha_v must be given");
+    if (has_u) {
+        mp.alpha_u = checked("alpha_u", 0.1f);
+        mp.alpha_v = checked("alpha_v", 0.1f);
+    } else {
+        mp.alpha_u = mp.alpha_v = checked("alpha", 0.1f);
+    }
+    return mp;
 }
+
+// Mitsuba reads a checkerboard as a float (eval_1) with its colours the other way round from the
+// colour reading (eval: color0 where both fractional parts are on the same side of 1/2; eval_1:
+// where they differ; measured in 3.9.1 too). A float parameter driven by a checkerboard gets a
+// copy with the colours swapped, so it agrees with Mitsuba (nested checkerboards inside its
+// colours are kept as they are).
+std::shared_ptr<const Texture> as_float_texture(std::shared_ptr<const Texture> t) {
+    if (std::holds_alternative<CheckerboardTexture>(t->v)) {
+        auto swapped = std::make_shared<Texture>(*t);
+        auto& sc = std::get<CheckerboardTexture>(swapped->v);
+        std::swap(sc.color0, sc.color1);
+        return swapped;
+    }
+    return t;
+}
+
+// Texture slots for the roughness of a conductor or dielectric (both have alpha_u, alpha_v).
+template <class B>
+void set_alpha(Bsdf& b, vec3 v) {
+    B& x = std::get<B>(b);
+    x.alpha_u = x.alpha_v = std::max(luminance(v), kMinAlpha);
+}
+template <class B>
+void set_alpha_u(Bsdf& b, vec3 v) { std::get<B>(b).alpha_u = std::max(luminance(v), kMinAlpha); }
+template <class B>
+void set_alpha_v(Bsdf& b, vec3 v) { std::get<B>(b).alpha_v = std::max(luminance(v), kMinAlpha); }
 
 ConductorBsdf conductor_params(Object& o) {
     ConductorBsdf c;
     std::string material = o.params.get_string("material", "none");
-    if (material != "none")
-        throw o.params.error("material", "named conductor '" + material + "' is not supported: give eta and k");
-    c.eta = nonnegative_rgb(o, "eta", vec3(0.f));
-    c.k = nonnegative_rgb(o, "k", vec3(1.f));
+    if (material != "none") {
+        // Mitsuba: a named material, or eta and k, not both.
+        if (o.params.has("eta") || o.params.has("k"))
+            throw o.params.error(o.params.has("eta") ? "eta" : "k", "give either material or eta and k, not both");
+        const NamedConductor* nc = named_conductor(material);
+        if (!nc) throw o.params.error("material", "unknown conductor material '" + material + "' (see docs/materials.md for Mitsuba's names)");
+        c.eta = nc->eta;
+        c.k = nc->k;
+    } else {
+        c.eta = nonnegative_rgb(o, "eta", vec3(0.f));
+        c.k = nonnegative_rgb(o, "k", vec3(1.f));
+    }
     c.specular_reflectance = nonnegative_rgb(o, "specular_reflectance", vec3(1.f));
     return c;
 }
 
 constexpr TexturableParam kConductorTextures[] = {
-    {"specular_reflectance", set_field<ConductorBsdf, &ConductorBsdf::specular_reflectance>}};
+    {"specular_reflectance", set_field<ConductorBsdf, &ConductorBsdf::specular_reflectance>},
+    {"alpha", set_alpha<ConductorBsdf>},
+    {"alpha_u", set_alpha_u<ConductorBsdf>},
+    {"alpha_v", set_alpha_v<ConductorBsdf>}};
 
 Material make_conductor(XmlLoader& L, Object& o) {
     return with_textures(L, o, Material{"", conductor_params(o), false}, {kConductorTextures[0]});
@@ -100,8 +173,12 @@ Material make_conductor(XmlLoader& L, Object& o) {
 
 Material make_roughconductor(XmlLoader& L, Object& o) {
     ConductorBsdf c = conductor_params(o);
-    c.alpha = microfacet_alpha(o, 0.1f);
-    return with_textures(L, o, Material{"", c, false}, {kConductorTextures[0]});
+    const MicrofacetParams mp = microfacet_params(L, o, true);
+    c.distribution = mp.type;
+    c.alpha_u = mp.alpha_u;
+    c.alpha_v = mp.alpha_v;
+    return with_textures(L, o, Material{"", c, false},
+                         {kConductorTextures[0], kConductorTextures[1], kConductorTextures[2], kConductorTextures[3]});
 }
 
 PlasticBsdf plastic_params(Object& o) {
@@ -126,7 +203,9 @@ Material make_plastic(XmlLoader& L, Object& o) {
 
 Material make_roughplastic(XmlLoader& L, Object& o) {
     PlasticBsdf p = plastic_params(o);
-    p.alpha = microfacet_alpha(o, 0.1f);
+    const MicrofacetParams mp = microfacet_params(L, o, false);  // Mitsuba: isotropic, no texture
+    p.distribution = mp.type;
+    p.alpha = mp.alpha_u;
     if (p.int_ior == p.ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
     p.prepare();
     return with_textures(L, o, Material{"", p, false}, {kPlasticTextures[0], kPlasticTextures[1]});
@@ -144,7 +223,10 @@ DielectricBsdf dielectric_params(Object& o) {
 
 constexpr TexturableParam kDielectricTextures[] = {
     {"specular_reflectance", set_field<DielectricBsdf, &DielectricBsdf::specular_reflectance>},
-    {"specular_transmittance", set_field<DielectricBsdf, &DielectricBsdf::specular_transmittance>}};
+    {"specular_transmittance", set_field<DielectricBsdf, &DielectricBsdf::specular_transmittance>},
+    {"alpha", set_alpha<DielectricBsdf>},
+    {"alpha_u", set_alpha_u<DielectricBsdf>},
+    {"alpha_v", set_alpha_v<DielectricBsdf>}};
 
 Material make_dielectric(XmlLoader& L, Object& o) {
     return with_textures(L, o, Material{"", dielectric_params(o), false}, {kDielectricTextures[0], kDielectricTextures[1]});
@@ -152,8 +234,23 @@ Material make_dielectric(XmlLoader& L, Object& o) {
 
 Material make_roughdielectric(XmlLoader& L, Object& o) {
     DielectricBsdf d = dielectric_params(o);
-    d.alpha = microfacet_alpha(o, 0.1f);
-    return with_textures(L, o, Material{"", d, false}, {kDielectricTextures[0], kDielectricTextures[1]});
+    const MicrofacetParams mp = microfacet_params(L, o, true);
+    d.distribution = mp.type;
+    d.alpha_u = mp.alpha_u;
+    d.alpha_v = mp.alpha_v;
+    return with_textures(L, o, Material{"", d, false},
+                         {kDielectricTextures[0], kDielectricTextures[1], kDielectricTextures[2], kDielectricTextures[3],
+                          kDielectricTextures[4]});
+}
+
+// Mitsuba's thindielectric: the IORs and the two tints, no roughness, no textures here.
+Material make_thindielectric(XmlLoader& L, Object& o) {
+    ThinDielectricBsdf t;
+    t.int_ior = ior_param(o, "int_ior", 1.5046f);
+    t.ext_ior = ior_param(o, "ext_ior", 1.000277f);
+    t.specular_reflectance = nonnegative_rgb(o, "specular_reflectance", vec3(1.f));
+    t.specular_transmittance = nonnegative_rgb(o, "specular_transmittance", vec3(1.f));
+    return with_textures(L, o, Material{"", t, false}, {});
 }
 
 Material make_twosided(XmlLoader& L, Object& o) {
@@ -176,6 +273,7 @@ const PluginTable<BsdfFactory>& bsdf_plugins() {
         {"roughplastic", make_roughplastic},
         {"dielectric", make_dielectric},
         {"roughdielectric", make_roughdielectric},
+        {"thindielectric", make_thindielectric},
         {"twosided", make_twosided},
         {"blendbsdf", blendbsdf_factory()},
         {"mask", mask_factory()},

@@ -1,0 +1,229 @@
+// Agreement with Mitsuba 3 of the microfacet plugins' values, named conductors and thindielectric:
+// tests/data/bsdf_values_mitsuba.txt holds Mitsuba's bsdf.eval for a table of direction pairs
+// (made by tests/data/make_bsdf_values.py); the same <bsdf> is read here by candela's XML
+// loader and evaluated. Also the XML rules of the new parameters (distribution, alpha_u/alpha_v,
+// material names) and the thindielectric's lobes.
+#include <gtest/gtest.h>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include "bsdf/bsdf.h"
+#include "bsdf/named_conductors.h"
+#include "core/error.h"
+#include "scene/loaders.h"
+#include "scene/scene.h"
+#include "support/render.h"
+#include "support/run.h"
+#include "support/stats.h"
+
+using namespace candela;
+
+namespace {
+
+std::string write_scene(const std::string& name, const std::string& bsdf_xml) {
+    const std::string path = candela::test::temp_dir("bsdf_mitsuba") + "/" + name + ".xml";
+    std::ofstream(path) << "<scene version=\"3.0.0\">\n<shape type=\"rectangle\">" << bsdf_xml << "</shape>\n</scene>\n";
+    return path;
+}
+
+Material load_material(const std::string& name, const std::string& bsdf_xml) {
+    SceneDescription s = load_mitsuba_xml(write_scene(name, bsdf_xml), {});
+    return s.materials[s.shapes.at(0).material];
+}
+
+std::string load_error(const std::string& name, const std::string& bsdf_xml) {
+    const std::string path = write_scene(name, bsdf_xml);
+    try {
+        load_mitsuba_xml(path, {});
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find(path + ":"), std::string::npos) << msg;  // file:line
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;  // one line
+        return msg;
+    }
+    return "<no error>";
+}
+
+}  // namespace
+
+// f(wo, wi) |cos wi| of candela against Mitsuba's bsdf.eval, for each BSDF of the table. The
+// values are float computations of the same formulas: 2e-4 relative (plus 1e-6 absolute) covers
+// their rounding; the plastic's coat tables are quadratures on both sides (Mitsuba's on a
+// different rule), so it gets 1 %.
+TEST(BsdfMitsuba, ValuesAgree) {
+    std::ifstream in(std::string(CANDELA_TEST_DATA) + "/bsdf_values_mitsuba.txt");
+    ASSERT_TRUE(in.good());
+    std::string line, xml;
+    Material m;
+    int n = 0, bsdfs = 0, nonzero = 0;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        if (line.rfind("bsdf ", 0) == 0) {
+            xml = line.substr(5);
+            m = load_material("table" + std::to_string(bsdfs++), xml);
+            prepare(m.bsdf);
+            continue;
+        }
+        std::istringstream ss(line);
+        vec3 wo, wi, expected;
+        ss >> wo.x >> wo.y >> wo.z >> wi.x >> wi.y >> wi.z >> expected.x >> expected.y >> expected.z;
+        const vec3 f = eval(m.bsdf, wo, wi, TransportMode::Radiance);
+        const float rel = xml.find("plastic") != std::string::npos ? 1e-2f : 2e-4f;
+        for (int k = 0; k < 3; ++k)
+            EXPECT_NEAR(f[k], expected[k], rel * std::abs(expected[k]) + 1e-6f)
+                << xml << "\n wo " << wo.x << " " << wo.y << " " << wo.z << " wi " << wi.x << " " << wi.y << " " << wi.z;
+        nonzero += expected.x > 0.f;
+        ++n;
+    }
+    EXPECT_EQ(bsdfs, 6);
+    EXPECT_GT(n, 140);
+    EXPECT_GT(nonzero, 100);
+}
+
+// Every name Mitsuba ships both tables for is accepted, with Mitsuba's RGB conversion (spot
+// checks against Mitsuba 3.9.1's mi.traverse values), and "none" is the (0, 1) mirror.
+TEST(BsdfMitsuba, NamedConductors) {
+    const std::vector<std::string> names = named_conductor_names();
+    EXPECT_EQ(names.size(), 71u);
+    for (const char* n : {"Ag", "Al", "Au", "Cu", "Cr", "W", "a-C", "d-C", "Cu_palik", "TiO2-e"})
+        EXPECT_NE(named_conductor(n), nullptr) << n;
+    const Material au = load_material("au", "<bsdf type=\"conductor\"><string name=\"material\" value=\"Au\"/></bsdf>");
+    const ConductorBsdf& c = std::get<ConductorBsdf>(au.bsdf);
+    EXPECT_NEAR(c.eta.x, 0.143036f, 1e-5f);
+    EXPECT_NEAR(c.eta.z, 1.44205f, 1e-4f);
+    EXPECT_NEAR(c.k.y, 2.38556f, 1e-4f);
+    const Material none = load_material("none", "<bsdf type=\"roughconductor\"><string name=\"material\" value=\"none\"/></bsdf>");
+    EXPECT_EQ(std::get<ConductorBsdf>(none.bsdf).eta, vec3(0.f));
+    EXPECT_EQ(std::get<ConductorBsdf>(none.bsdf).k, vec3(1.f));
+    EXPECT_NE(load_error("unknown", "<bsdf type=\"conductor\">\n<string name=\"material\" value=\"Unobtainium\"/></bsdf>")
+                  .find("unknown conductor material 'Unobtainium'"),
+              std::string::npos);
+}
+
+TEST(BsdfMitsuba, MicrofacetParameters) {
+    // Mitsuba's default distribution is Beckmann; alpha_u / alpha_v are anisotropic.
+    const Material d = load_material("default", "<bsdf type=\"roughconductor\"/>");
+    EXPECT_EQ(std::get<ConductorBsdf>(d.bsdf).distribution, MicrofacetType::Beckmann);
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(d.bsdf).alpha_u, 0.1f);
+    const Material a = load_material("aniso", "<bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"GGX\"/>"
+                                              "<float name=\"alpha_u\" value=\"0.2\"/><float name=\"alpha_v\" value=\"0.6\"/></bsdf>");
+    const DielectricBsdf& g = std::get<DielectricBsdf>(a.bsdf);
+    EXPECT_EQ(g.distribution, MicrofacetType::GGX);
+    EXPECT_FLOAT_EQ(g.alpha_u, 0.2f);
+    EXPECT_FLOAT_EQ(g.alpha_v, 0.6f);
+    const Material p = load_material("plastic", "<bsdf type=\"roughplastic\"/>");
+    EXPECT_EQ(std::get<PlasticBsdf>(p.bsdf).distribution, MicrofacetType::Beckmann);
+    // Refusals, one line with file:line each.
+    EXPECT_NE(load_error("bad_dist", "<bsdf type=\"roughconductor\">\n<string name=\"distribution\" value=\"phong\"/></bsdf>")
+                  .find("must be beckmann or ggx"),
+              std::string::npos);
+    EXPECT_NE(load_error("both", "<bsdf type=\"roughconductor\">\n<float name=\"alpha\" value=\"0.1\"/>"
+                                 "<float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"0.1\"/></bsdf>")
+                  .find("either alpha or alpha_u/alpha_v"),
+              std::string::npos);
+    EXPECT_NE(load_error("half", "<bsdf type=\"roughdielectric\">\n<float name=\"alpha_u\" value=\"0.1\"/></bsdf>")
+                  .find("both alpha_u and alpha_v"),
+              std::string::npos);
+    EXPECT_NE(load_error("iso", "<bsdf type=\"roughplastic\">\n<float name=\"alpha_u\" value=\"0.1\"/>"
+                                "<float name=\"alpha_v\" value=\"0.2\"/></bsdf>")
+                  .find("isotropic"),
+              std::string::npos);
+}
+
+// A roughness texture drives alpha (and alpha_u / alpha_v) per point, Mitsuba's float reading
+// of a texture (the luminance of its colour).
+TEST(BsdfMitsuba, TexturedRoughness) {
+    const Material m = load_material("tex", "<bsdf type=\"roughconductor\"><texture type=\"checkerboard\" name=\"alpha\">"
+                                            "<rgb name=\"color0\" value=\"0.05\"/><rgb name=\"color1\" value=\"0.6\"/>"
+                                            "</texture></bsdf>");
+    ASSERT_EQ(m.textures.size(), 1u);
+    EXPECT_STREQ(m.textures[0].parameter, "alpha");
+    Bsdf scratch;
+    std::vector<float> seen;
+    for (float u : {0.25f, 0.75f}) {
+        TextureQuery q;
+        q.uv = vec2(u, 0.25f);
+        const ConductorBsdf& c = std::get<ConductorBsdf>(bsdf_at(m, q, scratch));
+        EXPECT_EQ(c.alpha_u, c.alpha_v);
+        seen.push_back(c.alpha_u);
+    }
+    std::sort(seen.begin(), seen.end());
+    EXPECT_NEAR(seen[0], 0.05f, 1e-6f);
+    EXPECT_NEAR(seen[1], 0.6f, 1e-6f);
+    const Material d = load_material("texd", "<bsdf type=\"roughdielectric\"><texture type=\"checkerboard\" name=\"alpha_u\"/>"
+                                             "<float name=\"alpha_v\" value=\"0.3\"/></bsdf>");
+    EXPECT_EQ(d.textures.size(), 1u);
+}
+
+// thindielectric: R' = 2R / (1 + R) reflected, the rest straight through, from both sides;
+// sample frequencies against those probabilities (binomial z-test) and the weights are the tints.
+TEST(BsdfMitsuba, ThinDielectric) {
+    const Material m = load_material("thin", "<bsdf type=\"thindielectric\"><float name=\"int_ior\" value=\"1.5\"/>"
+                                             "<float name=\"ext_ior\" value=\"1.0\"/>"
+                                             "<rgb name=\"specular_transmittance\" value=\"0.9 0.8 0.7\"/></bsdf>");
+    const ThinDielectricBsdf& t = std::get<ThinDielectricBsdf>(m.bsdf);
+    // Normal incidence: R = 0.04, R' = 0.08 / 1.04.
+    EXPECT_NEAR(t.reflectance(1.f), 0.08f / 1.04f, 1e-6f);
+    for (float side : {1.f, -1.f})
+        for (float c : {0.9f, 0.3f}) {
+            const vec3 wo = side * vec3(safe_sqrt(1.f - c * c), 0.f, c);
+            PCG32 rng(11, 2);
+            const int n = 200000;
+            int refl = 0;
+            for (int i = 0; i < n; ++i) {
+                auto s = t.sample(wo, rng.next_float(), vec2(0.5f), TransportMode::Radiance);
+                ASSERT_TRUE(s && s->delta);
+                if (s->wi.z * wo.z > 0.f) {
+                    ++refl;
+                    EXPECT_NEAR(glm::length(s->wi - reflect_z(wo)), 0.f, 1e-6f);
+                    EXPECT_NEAR(s->weight().x, 1.f, 1e-6f);
+                } else {
+                    EXPECT_NEAR(glm::length(s->wi + wo), 0.f, 1e-6f);
+                    EXPECT_NEAR(s->weight().y, 0.8f, 1e-6f);
+                    EXPECT_EQ(s->eta, 1.f);
+                }
+            }
+            const double r = t.reflectance(c);
+            const stats::MeanTest z = stats::z_test(double(refl) / n, std::sqrt(r * (1 - r) / n), r);
+            EXPECT_GT(z.p_value, 1e-3) << z.describe();
+        }
+    EXPECT_EQ(t.pdf(vec3(0, 0, 1), vec3(0, 0, -1), TransportMode::Radiance), 0.f);
+}
+
+// ---- image agreement ------------------------------------------------------------------------------
+// tests/data/scenes/microfacet.xml (a Beckmann copper sphere, a GGX roughdielectric
+// pane with a textured alpha, a thindielectric pane, a Beckmann roughplastic cube) against the
+// mean of 16 Mitsuba 3.9.1 renders of 1024 spp at 32 x 32 and the variance of that mean, made by
+//   $PY tests/data/make_reference.py tests/data/scenes/microfacet.xml --res 32 --batches 16
+//       --spp 1024 --out tests/data/microfacet32
+// candela renders 16 batches of 128 spp; block z-test on 8 x 8 blocks. Control: the sphere with
+// GGX instead of Beckmann (same alpha) must fail. Anisotropy is not in the image: candela's
+// shading frame is built from the normal alone (core/frame.h), Mitsuba's from dp/du, so an
+// anisotropic highlight is oriented differently (the BSDF values agree, ValuesAgree).
+
+namespace {
+
+stats::ImageEstimate render_microfacet(const std::vector<std::pair<std::string, std::string>>& defines) {
+    auto d = defines;
+    d.push_back({"res", "32"});
+    auto built = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/microfacet.xml", d));
+    return candela::test::render_batch_estimate(*built, built->params(), 16, 128);
+}
+
+}  // namespace
+
+TEST(BsdfMitsuba, RenderAgreement) {
+    const stats::ImageEstimate ref = stats::ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/microfacet32");
+    ASSERT_EQ(ref.width, 32);
+    const stats::BlockTestResult r = stats::block_z_test(render_microfacet({}), ref, 8, 0.01);
+    std::printf("  microfacet scene: %s\n", r.describe().c_str());
+    EXPECT_TRUE(r.passed(0.01)) << r.describe();
+}
+
+TEST(BsdfMitsuba, RenderAgreementDetectsGgxForBeckmann) {
+    const stats::ImageEstimate ref = stats::ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/microfacet32");
+    const stats::BlockTestResult r = stats::block_z_test(render_microfacet({{"dist", "ggx"}}), ref, 8, 0.01);
+    std::printf("  ggx sphere for beckmann: %s\n", r.describe().c_str());
+    EXPECT_FALSE(r.passed(0.01)) << r.describe();
+}
