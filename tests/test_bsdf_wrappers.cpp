@@ -27,12 +27,14 @@ constexpr double kAlpha = 0.01;
 DiffuseBsdf diffuse(vec3 r) { return DiffuseBsdf{r}; }
 ConductorBsdf rough_metal(float alpha) {
     ConductorBsdf c;
-    c.alpha = alpha;
+    c.distribution = MicrofacetType::GGX;
+    c.alpha_u = c.alpha_v = alpha;
     return c;
 }
 DielectricBsdf rough_glass(float alpha) {
     DielectricBsdf d;
-    d.alpha = alpha;
+    d.distribution = MicrofacetType::GGX;
+    d.alpha_u = d.alpha_v = alpha;
     return d;
 }
 
