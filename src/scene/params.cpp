@@ -147,30 +147,27 @@ vec3 ParamSet::get_rgb(const std::string& name, vec3 def) const {
                                     (p->type == ParamType::Rgb ? " (expected 1 or 3 numbers)" : ""));
 }
 
-vec3 ParamSet::get_point(const std::string& name, vec3 def) const {
-    const Param* p = fetch(name, ParamType::Point, ParamType::Point);
-    if (!p) return def;
+// The three numbers of a <point> or <vector> (`what`), or an error naming the parameter.
+static vec3 parse_triple(const std::string& file, const Param& p, const char* what, const std::string& name) {
     std::vector<float> v;
     try {
-        v = parse_float_list(p->value);
+        v = parse_float_list(p.value);
     } catch (const std::invalid_argument&) {
         v.clear();
     }
-    if (v.size() != 3) throw Error(file_, p->line, "could not parse point '" + p->value + "' for parameter '" + name + "'");
+    if (v.size() != 3)
+        throw Error(file, p.line, std::string("could not parse ") + what + " '" + p.value + "' for parameter '" + name + "'");
     return vec3(v[0], v[1], v[2]);
+}
+
+vec3 ParamSet::get_point(const std::string& name, vec3 def) const {
+    const Param* p = fetch(name, ParamType::Point, ParamType::Point);
+    return p ? parse_triple(file_, *p, "point", name) : def;
 }
 
 vec3 ParamSet::get_vector(const std::string& name, vec3 def) const {
     const Param* p = fetch(name, ParamType::Vector, ParamType::Vector);
-    if (!p) return def;
-    std::vector<float> v;
-    try {
-        v = parse_float_list(p->value);
-    } catch (const std::invalid_argument&) {
-        v.clear();
-    }
-    if (v.size() != 3) throw Error(file_, p->line, "could not parse vector '" + p->value + "' for parameter '" + name + "'");
-    return vec3(v[0], v[1], v[2]);
+    return p ? parse_triple(file_, *p, "vector", name) : def;
 }
 
 mat4 ParamSet::get_transform(const std::string& name, const mat4& def) const {
