@@ -116,6 +116,15 @@ inline void prepare(Bsdf& b) {
     }, b);
 }
 
+// Whether a BSDF's lobes depend on the azimuth of the tangent frame (alpha_u != alpha_v).
+inline bool is_anisotropic(const Bsdf& b) {
+    return std::visit([](const auto& x) {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, ConductorBsdf> || std::is_same_v<T, DielectricBsdf>) return x.alpha_u != x.alpha_v;
+        else return false;
+    }, b);
+}
+
 // A BSDF parameter driven by a texture. `apply` writes the texture's value at a surface point into
 // the parameter it drives; the loader, which knows the BSDF's type and parameter, chooses it.
 struct TextureSlot {
@@ -165,6 +174,9 @@ struct Material {
     float bump_scale = 1.f;                  // bumpmap `scale`
     bool shadow_terminator = true;           // Mitsuba's use_shadowing_function (Estevez et al. 2019)
     bool flip_invalid_normals = true;        // Mitsuba's flip_invalid_normals
+    // Some BSDF of the material is anisotropic: its shading frame follows dp/du (Frame::from_tangent,
+    // as Mitsuba's), not only the normal. Derived by prepare(Material&); isotropic materials skip it.
+    bool tangent_frame = false;
     bool masked = false;                     // mask or null: the surface lets part of the light through
     float opacity = 1.f;                     // mask `opacity` in [0, 1] (null: 0)
     std::shared_ptr<const Texture> opacity_texture;  // null: `opacity` is the value
@@ -189,6 +201,21 @@ struct Material {
         return std::clamp(opacity_texture->eval_1(q), 0.f, 1.f);
     }
 };
+
+// Derives what a material precomputes: its BSDFs' tables (prepare(Bsdf&)) and tangent_frame.
+inline void prepare(Material& m) {
+    prepare(m.bsdf);
+    for (MaterialLeaf& l : m.extra_leaves) prepare(l.bsdf);
+    // A textured alpha_u or alpha_v may differ from its partner at some point.
+    auto anisotropic = [](const Bsdf& b, const std::vector<TextureSlot>& tex) {
+        if (is_anisotropic(b)) return true;
+        for (const TextureSlot& t : tex)
+            if (std::string(t.parameter) == "alpha_u" || std::string(t.parameter) == "alpha_v") return true;
+        return false;
+    };
+    m.tangent_frame = anisotropic(m.bsdf, m.textures);
+    for (const MaterialLeaf& l : m.extra_leaves) m.tangent_frame = m.tangent_frame || anisotropic(l.bsdf, l.textures);
+}
 
 // A leaf's BSDF at a surface point: its own when nothing is textured (no copy, the case of every
 // untextured scene), else a copy in `scratch` with its textured parameters evaluated at `q`.

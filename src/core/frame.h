@@ -17,6 +17,19 @@ struct Frame {
         s = vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x);
         t = vec3(b, sign + n.y * n.y * a, -n.y);
     }
+    // The frame of Mitsuba's SurfaceInteraction::initialize_sh_frame: s is the tangent made
+    // orthogonal to n (Gram-Schmidt), t = n x s. For anisotropic BSDFs, whose x axis must follow
+    // the surface's dp/du. A tangent parallel to n (or not finite) falls back to Frame(n).
+    static Frame from_tangent(vec3 normal, vec3 tangent) {
+        vec3 s = tangent - normal * glm::dot(normal, tangent);
+        const float l2 = glm::dot(s, s);
+        if (!(l2 > 1e-20f * glm::dot(tangent, tangent)) || !std::isfinite(l2)) return Frame(normal);
+        Frame f;
+        f.n = normal;
+        f.s = s / std::sqrt(l2);
+        f.t = glm::cross(normal, f.s);
+        return f;
+    }
     vec3 to_local(vec3 v) const { return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
     vec3 to_world(vec3 v) const { return s * v.x + t * v.y + n * v.z; }
 

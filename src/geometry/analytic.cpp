@@ -296,6 +296,12 @@ SurfaceInteraction analytic_interaction(const AnalyticShape& s, const Hit& hit) 
             double theta = std::acos(std::clamp(l.z, -1.0, 1.0));
             si.uv = vec2(float(wrap_phi(l.y, l.x) / (2.0 * 3.14159265358979323846)),
                          float(theta / 3.14159265358979323846));
+            // Mitsuba's dp/du = 2 pi r R (-y, x, 0), dp/dv = pi r R (z cos phi, z sin phi, -rd) of
+            // the local point, (1, 0, 0) for dp/dv at the poles; R = to_object^T (a rotation).
+            const dmat3 R = glm::transpose(dmat3(s.to_object));
+            const double rd = std::sqrt(l.x * l.x + l.y * l.y), pi = 3.14159265358979323846;
+            si.dpdu = vec3(R * dvec3(-l.y, l.x, 0.0) * (2.0 * pi * s.radius));
+            si.dpdv = vec3(R * (rd > 0.0 ? dvec3(l.z * l.x / rd, l.z * l.y / rd, -rd) : dvec3(1.0, 0.0, 0.0)) * (pi * s.radius));
             break;
         }
         case PrimKind::Disk: {
@@ -304,6 +310,12 @@ SurfaceInteraction analytic_interaction(const AnalyticShape& s, const Hit& hit) 
             si.ng = si.ns = s.normal;
             si.uv = vec2(std::sqrt(q.x * q.x + q.y * q.y),
                          float(wrap_phi(q.y, q.x) / (2.0 * 3.14159265358979323846)));
+            {   // Mitsuba's: dp/du = L (cos phi, sin phi, 0), dp/dv = 2 pi r L (-sin phi, cos phi, 0)
+                const float r = si.uv.x, c = r > 0.f ? q.x / r : 1.f, sn = r > 0.f ? q.y / r : 0.f;
+                const glm::mat3 L(s.to_world);
+                si.dpdu = L * vec3(c, sn, 0.f);
+                si.dpdv = L * vec3(-sn, c, 0.f) * (2.f * kPi * r);
+            }
             break;
         }
         case PrimKind::Cylinder: {
@@ -312,6 +324,11 @@ SurfaceInteraction analytic_interaction(const AnalyticShape& s, const Hit& hit) 
             si.p = transform_point_error(s.to_world, q, pe, &si.p_error);
             si.ng = si.ns = cylinder_normal(s, q);
             si.uv = vec2(float(wrap_phi(q.y, q.x) / (2.0 * 3.14159265358979323846)), q.z / s.length);
+            {   // Mitsuba's: dp/du = 2 pi F (-y, x, 0), dp/dv = F (0, 0, length) in the rigid frame F
+                const glm::mat3 F(s.to_world);
+                si.dpdu = F * vec3(-q.y, q.x, 0.f) * (2.f * kPi);
+                si.dpdv = F * vec3(0.f, 0.f, s.length);
+            }
             break;
         }
         case PrimKind::Triangle: break;

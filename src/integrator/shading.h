@@ -116,7 +116,9 @@ inline void shade(const Scene& sc, const Hit& hit, SurfaceInteraction& si, vec3 
         n = -n;
         si.ng = -si.ng;
     }
-    sh.frame = Frame(n);
+    // Seen from the back, from_tangent keeps s and negates t: an anisotropic lobe (even in x and y)
+    // is the same as under Mitsuba's twosided, which negates z instead.
+    sh.frame = !DiffuseOnly && mat.tangent_frame ? Frame::from_tangent(n, si.dpdu) : Frame(n);
     sh.wo = sh.frame.to_local(wo_world);
     if (DiffuseOnly || mat.plain()) {
         sh.is_wrapped = false;

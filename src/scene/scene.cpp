@@ -98,10 +98,7 @@ void check_vertex_runs(const std::string& source, const Mesh& mesh, const std::v
 }
 
 std::vector<Material> prepared(std::vector<Material> materials) {
-    for (Material& m : materials) {
-        prepare(m.bsdf);
-        for (MaterialLeaf& l : m.extra_leaves) prepare(l.bsdf);
-    }
+    for (Material& m : materials) prepare(m);
     return materials;
 }
 
