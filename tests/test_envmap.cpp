@@ -6,8 +6,8 @@
 //   L / pdf to the map's integral (both estimated with uniform directions, independent of the
 //   lat-long mapping); sample_le's directions match pdf_le; no NaN or inf at the poles.
 // * eval against Mitsuba: tests/data/envmap_eval_mitsuba.txt (make_envmap_reference.py: Mitsuba
-//   3.9.1 scalar_rgb eval for 90 directions and three cases: an EXR, the EXR turned and scaled,
-//   an sRGB PNG), each within 1e-3 relative.
+//   3.9.1 scalar_rgb eval for 90 directions and four cases: an EXR, the EXR turned and scaled,
+//   an sRGB PNG, an RGBE .hdr), each within 1e-3 relative.
 // * an image against Mitsuba: tests/data/scenes/envmap.xml (a diffuse and a rough-conductor sphere
 //   on a floor under the turned, scaled map, which is also seen directly), reference
 //   tests/data/envmap_scene_{mean,var}.exr, block z-test; controls: 3% dimmer and the map turned
@@ -255,6 +255,7 @@ TEST(Envmap, EvalMatchesMitsuba) {
     cases["rot"] = rotated_light();
     cases["exr"].map = EnvironmentMap::load(data("textures/envmap_quadrants.exr"));
     cases["png"].map = EnvironmentMap::load(data("textures/envmap_small.png"));
+    cases["hdr"].map = EnvironmentMap::load(data("textures/envmap_quadrants.hdr"));
     for (auto& c : cases) c.second.update();
     std::string line;
     int n = 0, bad = 0;
@@ -275,7 +276,7 @@ TEST(Envmap, EvalMatchesMitsuba) {
                 break;
             }
     }
-    EXPECT_EQ(n, 270);
+    EXPECT_EQ(n, 360);
     EXPECT_EQ(bad, 0);
 }
 
@@ -399,6 +400,17 @@ TEST(Envmap, XmlDefaultsAndParameters) {
     EXPECT_STREQ(light_type_name(d.lights[0].model), "envmap");
     EXPECT_STREQ(light_strength_name(d.lights[0].model), "scale");
     EXPECT_EQ(light_flags(d.lights[0].model), uint32_t(kLightInfinite));
+    // The viewer's edits (scale, rotation) make a different light; the map is shared, not copied.
+    Light turned = d.lights[0];
+    EXPECT_TRUE(same_light(turned, d.lights[0]));
+    std::get<EnvmapLight>(turned.model).rotation = 30.f;
+    std::get<EnvmapLight>(turned.model).update();
+    EXPECT_FALSE(same_light(turned, d.lights[0]));
+    EXPECT_NE(std::get<EnvmapLight>(turned.model).frame, e->frame);
+    EXPECT_EQ(std::get<EnvmapLight>(turned.model).map, e->map);
+    Light brighter = d.lights[0];
+    light_strength(brighter.model) *= 2.f;
+    EXPECT_FALSE(same_light(brighter, d.lights[0]));
 }
 
 TEST(Envmap, BadInputIsOneLineWithFileAndLine) {

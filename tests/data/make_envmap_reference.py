@@ -8,12 +8,14 @@
    image, a gradient along u, a bright 2 x 1 "sun" at pixels (17..18, 3) and a dim bottom row, so
    that any mirror, swap or offset of the lat-long orientation changes the answer.
    tests/data/textures/envmap_small.png (8 x 6, sRGB 8 bit): the same idea through the PNG decode.
+   tests/data/textures/envmap_quadrants.hdr: the EXR written as RGBE (Radiance HDR).
 2. tests/data/envmap_eval_mitsuba.txt: `case dx dy dz r g b` per line, Mitsuba's envmap eval
    (scalar_rgb, a SurfaceInteraction whose wi = -d) for directions d on the sphere (random, the
    axes, the poles and the seam), for the cases
      exr   the EXR, scale 1, no to_world
      rot   the EXR, scale 2.5, to_world = rotate(y, 70) * rotate(x, 30)
      png   the PNG, scale 1
+     hdr   the RGBE file, scale 1
 3. --images: tests/data/envmap_scene_{mean,var}.exr from tests/data/scenes/envmap.xml through
    make_reference.py (llvm_ad_rgb, 16 batches x 1024 spp, 32 x 32).
 """
@@ -69,7 +71,9 @@ def main():
     tex = os.path.join(HERE, "textures")
     exr = os.path.join(tex, "envmap_quadrants.exr")
     png = os.path.join(tex, "envmap_small.png")
+    hdr = os.path.join(tex, "envmap_quadrants.hdr")
     mi.Bitmap(quadrant_image()).write(exr)
+    mi.Bitmap(quadrant_image()).write(hdr)
     small_png(mi, png)
 
     T = mi.ScalarTransform4f
@@ -78,6 +82,7 @@ def main():
         "rot": {"type": "envmap", "filename": exr, "scale": 2.5,
                 "to_world": T().rotate([0, 1, 0], 70) @ T().rotate([1, 0, 0], 30)},
         "png": {"type": "envmap", "filename": png},
+        "hdr": {"type": "envmap", "filename": hdr},
     }
     rng = np.random.default_rng(7)
     dirs = directions(rng)
