@@ -96,7 +96,7 @@ public:
                alights_.capacity() * sizeof(uint32_t) + analytic_light_.capacity() * sizeof(int32_t) +
                analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes() +
                lights_.capacity() * sizeof(Light) + infinite_.capacity() * sizeof(uint32_t) +
-               emitter_texture_.capacity() * sizeof(const Texture*);
+               emitter_texture_.capacity() * sizeof(const Texture*) + envmap_bytes();
     }
 
 private:
@@ -127,6 +127,12 @@ private:
     float area_pmf_ = 1.f;      // choice_pmf_ when there are area lights
 
     bool has_area() const { return !tris_.empty() || !alights_.empty(); }
+    size_t envmap_bytes() const {
+        size_t n = 0;
+        for (const Light& l : lights_)
+            if (const EnvmapLight* e = std::get_if<EnvmapLight>(&l.model)) n += e->map ? e->map->memory_bytes() : 0;
+        return n;
+    }
     bool sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const;
 };
 

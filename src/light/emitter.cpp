@@ -22,7 +22,28 @@ vec3 disk_point(const SceneSphere& s, vec3 w, vec2 u) {
     return s.center + s.radius * (f.s * d.x + f.t * d.y);
 }
 
+// Solid-angle density of a direction of the envmap from its density in uv (light/envmap.h):
+// dw = 2 pi^2 sin(theta) du dv. sin(theta) is floored as Mitsuba's pdf_direction does, so that
+// the poles give a large finite density, never inf or NaN.
+float envmap_pdf_sa(float pdf_uv, float sin_theta) {
+    return pdf_uv / (2.f * kPi * kPi * std::max(sin_theta, 1e-7f));
+}
+
+float envmap_pdf_li(const EnvmapLight& l, vec3 w) {
+    const vec3 d = l.to_local(w);
+    const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
+    return envmap_pdf_sa(l.map->pdf(EnvironmentMap::direction_to_uv(d)), sin_theta);
+}
+
 }  // namespace
+
+void EnvmapLight::update() {
+    const float a = radians(rotation), c = std::cos(a), s = std::sin(a);
+    // A turn by `rotation` about local +y (right-handed: +z towards +x).
+    const glm::mat3 ry(vec3(c, 0.f, -s), vec3(0.f, 1.f, 0.f), vec3(s, 0.f, c));
+    frame = to_world * ry;
+    frame_inv = glm::inverse(frame);
+}
 
 vec3 SpotLight::profile(vec3 d) const {
     const float cutoff = radians(cutoff_angle), beam = radians(beam_width);
@@ -45,14 +66,16 @@ uint32_t light_flags(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return uint32_t(kLightDeltaPosition); },
                                  [](const SpotLight&) { return uint32_t(kLightDeltaPosition); },
                                  [](const DirectionalLight&) { return uint32_t(kLightDeltaDirection | kLightInfinite); },
-                                 [](const ConstantLight&) { return uint32_t(kLightInfinite); }},
+                                 [](const ConstantLight&) { return uint32_t(kLightInfinite); },
+                                 [](const EnvmapLight&) { return uint32_t(kLightInfinite); }},
                       m);
 }
 
 const char* light_type_name(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return "point"; }, [](const SpotLight&) { return "spot"; },
                                  [](const DirectionalLight&) { return "directional"; },
-                                 [](const ConstantLight&) { return "constant"; }},
+                                 [](const ConstantLight&) { return "constant"; },
+                                 [](const EnvmapLight&) { return "envmap"; }},
                       m);
 }
 
@@ -60,7 +83,8 @@ vec3& light_strength(LightModel& m) {
     return std::visit(overloaded{[](PointLight& l) -> vec3& { return l.intensity; },
                                  [](SpotLight& l) -> vec3& { return l.intensity; },
                                  [](DirectionalLight& l) -> vec3& { return l.irradiance; },
-                                 [](ConstantLight& l) -> vec3& { return l.radiance; }},
+                                 [](ConstantLight& l) -> vec3& { return l.radiance; },
+                                 [](EnvmapLight& l) -> vec3& { return l.scale; }},
                       m);
 }
 vec3 light_strength(const LightModel& m) { return light_strength(const_cast<LightModel&>(m)); }
@@ -68,7 +92,8 @@ vec3 light_strength(const LightModel& m) { return light_strength(const_cast<Ligh
 const char* light_strength_name(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return "intensity"; }, [](const SpotLight&) { return "intensity"; },
                                  [](const DirectionalLight&) { return "irradiance"; },
-                                 [](const ConstantLight&) { return "radiance"; }},
+                                 [](const ConstantLight&) { return "radiance"; },
+                                 [](const EnvmapLight&) { return "scale"; }},
                       m);
 }
 
@@ -82,7 +107,11 @@ bool same_light(const Light& a, const Light& b) {
                               l.beam_width == o.beam_width && l.texture == o.texture;
                    },
                    [&](const DirectionalLight& l) { return l.direction == std::get<DirectionalLight>(b.model).direction; },
-                   [&](const ConstantLight&) { return true; }},
+                   [&](const ConstantLight&) { return true; },
+                   [&](const EnvmapLight& l) {
+                       const EnvmapLight& o = std::get<EnvmapLight>(b.model);
+                       return l.map == o.map && l.to_world == o.to_world && l.rotation == o.rotation;
+                   }},
         a.model);
 }
 
@@ -144,16 +173,36 @@ bool sample_li(const LightModel& m, const SceneSphere& sphere, vec3 ref_p, vec2 
                 out.delta = false;
                 out.infinite = true;
                 return true;
+            },
+            [&](const EnvmapLight& l) {
+                vec2 uv;
+                float pdf_uv, sin_theta;
+                if (!l.map->sample(u, uv, pdf_uv)) return false;
+                vec3 d = EnvironmentMap::uv_to_direction(uv, sin_theta);
+                if (!(sin_theta > 0.f)) return false;  // a pole: measure zero
+                out.wi = l.from_local(d);
+                out.dist = kInfinity;
+                out.p = ref_p;
+                out.n = -out.wi;
+                out.Le = l.scale * l.map->eval(uv);
+                out.pdf = envmap_pdf_sa(pdf_uv, sin_theta);
+                out.delta = false;
+                out.infinite = true;
+                return std::isfinite(out.pdf) && out.pdf > 0.f;
             }},
         m);
 }
 
-float pdf_li(const LightModel& m, vec3) {
-    return std::holds_alternative<ConstantLight>(m) ? kInv4Pi : 0.f;
+float pdf_li(const LightModel& m, vec3 w) {
+    if (std::holds_alternative<ConstantLight>(m)) return kInv4Pi;
+    if (const EnvmapLight* e = std::get_if<EnvmapLight>(&m)) return envmap_pdf_li(*e, w);
+    return 0.f;
 }
 
-vec3 eval_infinite(const LightModel& m, vec3) {
+vec3 eval_infinite(const LightModel& m, vec3 w) {
     if (const ConstantLight* c = std::get_if<ConstantLight>(&m)) return c->radiance;
+    if (const EnvmapLight* e = std::get_if<EnvmapLight>(&m))
+        return e->scale * e->map->eval(EnvironmentMap::direction_to_uv(e->to_local(w)));
     return vec3(0.f);
 }
 
@@ -198,6 +247,21 @@ std::optional<EmissionSample> sample_le(const LightModel& m, const SceneSphere& 
                        es.pdf_pos = 1.f / (kPi * sphere.radius * sphere.radius);
                        es.pdf_dir = kInv4Pi;
                        return true;
+                   },
+                   [&](const EnvmapLight& l) {
+                       vec2 uv;
+                       float pdf_uv, sin_theta;
+                       if (!l.map->sample(u_dir, uv, pdf_uv)) return false;
+                       vec3 d = EnvironmentMap::uv_to_direction(uv, sin_theta);
+                       if (!(sin_theta > 0.f)) return false;
+                       vec3 w = l.from_local(d);  // towards the light
+                       es.ray.o = disk_point(sphere, w, u_pos) + sphere.radius * w;
+                       es.ray.d = -w;
+                       es.n = -w;
+                       es.Le = l.scale * l.map->eval(uv);
+                       es.pdf_pos = 1.f / (kPi * sphere.radius * sphere.radius);
+                       es.pdf_dir = envmap_pdf_sa(pdf_uv, sin_theta);
+                       return std::isfinite(es.pdf_dir) && es.pdf_dir > 0.f;
                    }},
         m);
     if (!ok) return std::nullopt;
@@ -221,6 +285,10 @@ void pdf_le(const LightModel& m, const SceneSphere& sphere, vec3 d, float& pdf_p
                           [&](const ConstantLight&) {
                               pdf_pos = disk;
                               pdf_dir = kInv4Pi;
+                          },
+                          [&](const EnvmapLight& l) {
+                              pdf_pos = disk;
+                              pdf_dir = envmap_pdf_li(l, -d);  // d travels away from the light
                           }},
                m);
 }

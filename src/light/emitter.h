@@ -1,17 +1,17 @@
 #pragma once
 // The emitters that are not attached to a shape: Mitsuba 3.9's `point`, `spot`, `directional` and
-// `constant` (src/emitters/*.cpp), a closed set dispatched through std::variant. Area emitters live
+// `constant` and `envmap` (src/emitters/*.cpp), a closed set dispatched through std::variant. Area emitters live
 // with their shapes in LightSet (light/area.h), which samples every light of the scene.
 //
 // Conventions (world space throughout, directions unit length):
 //   wi        direction from the reference point towards the light
 //   w (eval)  direction from the scene out to an infinite light (= the escaping ray's direction)
 //   Li        what sample_li returns as LightSample::Le:
-//               area, constant: radiance arriving along -wi (W m^-2 sr^-1)
+//               area, constant, envmap: radiance arriving along -wi (W m^-2 sr^-1)
 //               point, spot:    intensity / dist^2 (the delta position is folded in)
 //               directional:    irradiance at a surface facing it
 //             so that the direct-light estimate is always f(wo, wi) |cos| Le / pdf.
-//   pdf       area, constant: solid angle at the reference point; delta lights: 1 (a discrete
+//   pdf       area, constant, envmap: solid angle at the reference point; delta lights: 1 (a discrete
 //             choice). LightSet multiplies in the pmf of choosing the light.
 //   sample_le a ray leaving the light (for light tracing, BDPT, MLT) with Le the radiance it
 //             carries (point, spot: intensity; directional: irradiance), pdf_pos (area measure on
@@ -25,6 +25,7 @@
 #include <variant>
 #include "core/frame.h"
 #include "core/ray.h"
+#include "light/envmap.h"
 #include "texture/texture.h"
 
 namespace candela {
@@ -99,7 +100,24 @@ struct ConstantLight {
     vec3 radiance{1.f};
 };
 
-using LightModel = std::variant<PointLight, SpotLight, DirectionalLight, ConstantLight>;
+// Mitsuba's `envmap`: radiance scale * map(uv(to_local(w))) arriving from direction w, the map in
+// Mitsuba's lat-long orientation (light/envmap.h), importance sampled by its luminance. `scale` is
+// Mitsuba's float scale, per channel here so that the viewer edits it as it edits a radiance.
+// `rotation` (degrees) turns the map about its own up axis (local +y) before to_world; the viewer
+// edits it. Call update() after changing to_world or rotation.
+struct EnvmapLight {
+    std::shared_ptr<const EnvironmentMap> map;
+    vec3 scale{1.f};
+    glm::mat3 to_world{1.f};  // the linear part of the XML's to_world
+    float rotation = 0.f;
+
+    glm::mat3 frame{1.f}, frame_inv{1.f};  // local -> world and back, rotation included
+    void update();
+    vec3 to_local(vec3 w) const { return glm::normalize(frame_inv * w); }
+    vec3 from_local(vec3 d) const { return glm::normalize(frame * d); }
+};
+
+using LightModel = std::variant<PointLight, SpotLight, DirectionalLight, ConstantLight, EnvmapLight>;
 
 struct Light {
     std::string name;  // the XML id, or "<type> k"
@@ -108,7 +126,7 @@ struct Light {
 
 uint32_t light_flags(const LightModel& m);
 const char* light_type_name(const LightModel& m);  // Mitsuba's plugin name
-// The parameter the viewer edits: intensity, irradiance or radiance.
+// The parameter the viewer edits: intensity, irradiance, radiance or (envmap) scale.
 vec3& light_strength(LightModel& m);
 vec3 light_strength(const LightModel& m);
 const char* light_strength_name(const LightModel& m);

@@ -129,6 +129,16 @@ bool edit_material(Material& m) {
 
 bool edit_emitter(AreaEmitter& e) { return drag_positive("radiance", e.radiance, 0.05f); }
 
-bool edit_light(Light& l) { return drag_positive(light_strength_name(l.model), light_strength(l.model), 0.05f); }
+bool edit_light(Light& l) {
+    bool changed = drag_positive(light_strength_name(l.model), light_strength(l.model), 0.05f);
+    if (EnvmapLight* e = std::get_if<EnvmapLight>(&l.model)) {
+        // A turn of the map about its up axis: only the frame changes, the sampling table stays.
+        if (ImGui::SliderFloat("rotation", &e->rotation, -180.f, 180.f, "%.1f deg")) {
+            e->update();
+            changed = true;
+        }
+    }
+    return changed;
+}
 
 }  // namespace candela

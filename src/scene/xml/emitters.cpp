@@ -1,6 +1,7 @@
 // The emitter family of the XML reader, one table for every emitter plugin: `area` (nested in a
-// shape, or referenced by one) and the top-level `point`, `spot`, `directional` and `constant`
-// (light/emitter.h). `envmap` is refused until the environment map class is wired in.
+// shape, or referenced by one) and the top-level `point`, `spot`, `directional`, `constant` and
+// `envmap` (light/emitter.h). As Mitsuba's Scene, a scene takes at most one environment emitter
+// (an infinite light that is not a delta: constant or envmap).
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -82,8 +83,29 @@ EmitterModel make_constant(XmlLoader&, Object& e) {
     return ConstantLight{strength(e, "radiance")};
 }
 
-EmitterModel refuse_envmap(XmlLoader& L, Object& e) {
-    throw L.error(e.node, "emitter 'envmap' is not supported yet (the environment map is not wired in)");
+EmitterModel make_envmap(XmlLoader& L, Object& e) {
+    EnvmapLight l;
+    if (e.params.has("bitmap")) throw e.params.error("bitmap", "envmap: a 'bitmap' object is not supported; give 'filename'");
+    const std::string file = e.params.get_string("filename", "");
+    if (file.empty()) throw L.error(e.node, "envmap needs a filename");
+    const std::string path = L.resolve(e.node, file);
+    try {
+        l.map = EnvironmentMap::load(path);
+    } catch (const Error& err) {
+        // The image's problem, at the scene's line.
+        throw e.params.error("filename", std::string("envmap: ") + err.what());
+    }
+    const float scale = e.params.get_float("scale", 1.f);
+    if (!std::isfinite(scale) || !(scale >= 0.f)) throw e.params.error("scale", "scale must be finite and not negative");
+    l.scale = vec3(scale);
+    // mis_compensation changes only how Mitsuba samples the map (not the image): accepted, unused.
+    (void)e.params.get_bool("mis_compensation", false);
+    const mat4 m = e.params.get_transform("to_world", mat4(1.f));
+    l.to_world = glm::mat3(m);
+    const float det = glm::determinant(l.to_world);
+    if (!(det != 0.f) || !std::isfinite(det)) throw e.params.error("to_world", "envmap: to_world is singular");
+    l.update();
+    return l;
 }
 
 }  // namespace
@@ -91,7 +113,7 @@ EmitterModel refuse_envmap(XmlLoader& L, Object& e) {
 const PluginTable<EmitterFactory>& emitter_plugins() {
     static const PluginTable<EmitterFactory> table = {
         {"area", make_area},           {"point", make_point},       {"spot", make_spot},
-        {"directional", make_directional}, {"constant", make_constant}, {"envmap", refuse_envmap},
+        {"directional", make_directional}, {"constant", make_constant}, {"envmap", make_envmap},
     };
     return table;
 }
@@ -102,7 +124,7 @@ EmitterFactory find_emitter(XmlLoader& L, const Object& e) {
         if (e.type == p.type) return p.make;
     std::string known;
     for (const auto& p : emitter_plugins())
-        if (std::string(p.type) != "envmap") known += (known.empty() ? "" : ", ") + std::string(p.type);
+        known += (known.empty() ? "" : ", ") + std::string(p.type);
     throw L.error(e.node, "unsupported emitter type '" + e.type + "' (candela supports: " + known + ")");
 }
 }  // namespace
@@ -128,6 +150,12 @@ void load_emitter(XmlLoader& L, pugi::xml_node n) {
         else return v;
     }, m);
     std::vector<Light>& lights = L.scene().lights;
+    auto environment = [](const Light& x) {
+        return (light_flags(x.model) & (kLightInfinite | kLightDeltaDirection)) == kLightInfinite;
+    };
+    if (environment(l))
+        for (const Light& o : lights)
+            if (environment(o)) throw L.error(n, "only one environment emitter (constant or envmap) can be specified per scene, as in Mitsuba");
     l.name = n.attribute("id") ? std::string(n.attribute("id").value())
                                : std::string(light_type_name(l.model)) + " " + std::to_string(lights.size());
     lights.push_back(std::move(l));
