@@ -21,6 +21,7 @@
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
 #include "bsdf/plastic.h"
+#include "bsdf/principled.h"
 #include "bsdf/thindielectric.h"
 #include "texture/texture.h"
 
@@ -32,8 +33,9 @@ namespace candela {
 //   PlasticBsdf     dielectric coat over a diffuse base          (`plastic`, `roughplastic`)
 //   DielectricBsdf  glass, smooth (alpha 0) or rough             (`dielectric`, `roughdielectric`)
 //   ThinDielectricBsdf  a thin pane: reflection + straight through (`thindielectric`)
+//   PrincipledBsdf  Burley's principled model as Mitsuba 3.9 has it (`principled`)
 // docs/materials.md describes each model and its tests.
-using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf>;
+using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf, PrincipledBsdf>;
 
 // Dispatch that knows only the diffuse BSDF, as a diffuse-only renderer would have it; any other
 // BSDF renders black. Used in two places: the whole dispatch of the yardstick build for issue 6
