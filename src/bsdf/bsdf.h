@@ -21,6 +21,7 @@
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
 #include "bsdf/plastic.h"
+#include "bsdf/principled.h"
 #include "bsdf/thindielectric.h"
 #include "texture/texture.h"
 
@@ -32,8 +33,9 @@ namespace candela {
 //   PlasticBsdf     dielectric coat over a diffuse base          (`plastic`, `roughplastic`)
 //   DielectricBsdf  glass, smooth (alpha 0) or rough             (`dielectric`, `roughdielectric`)
 //   ThinDielectricBsdf  a thin pane: reflection + straight through (`thindielectric`)
+//   PrincipledBsdf  Burley's principled model as Mitsuba 3.9 has it (`principled`)
 // docs/materials.md describes each model and its tests.
-using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf>;
+using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf, PrincipledBsdf>;
 
 // Dispatch that knows only the diffuse BSDF, as a diffuse-only renderer would have it; any other
 // BSDF renders black. Used in two places: the whole dispatch of the yardstick build for issue 6
@@ -116,11 +118,13 @@ inline void prepare(Bsdf& b) {
     }, b);
 }
 
-// Whether a BSDF's lobes depend on the azimuth of the tangent frame (alpha_u != alpha_v).
+// Whether a BSDF's lobes depend on the azimuth of the tangent frame (alpha_u != alpha_v, or a
+// principled `anisotropic` above 0).
 inline bool is_anisotropic(const Bsdf& b) {
     return std::visit([](const auto& x) {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, ConductorBsdf> || std::is_same_v<T, DielectricBsdf>) return x.alpha_u != x.alpha_v;
+        else if constexpr (std::is_same_v<T, PrincipledBsdf>) return x.anisotropic > 0.f;
         else return false;
     }, b);
 }
@@ -210,7 +214,9 @@ inline void prepare(Material& m) {
     auto anisotropic = [](const Bsdf& b, const std::vector<TextureSlot>& tex) {
         if (is_anisotropic(b)) return true;
         for (const TextureSlot& t : tex)
-            if (std::string(t.parameter) == "alpha_u" || std::string(t.parameter) == "alpha_v") return true;
+            if (std::string(t.parameter) == "alpha_u" || std::string(t.parameter) == "alpha_v" ||
+                std::string(t.parameter) == "anisotropic")
+                return true;
         return false;
     };
     m.tangent_frame = anisotropic(m.bsdf, m.textures);

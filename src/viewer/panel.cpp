@@ -87,6 +87,36 @@ bool edit_bsdf(T& b) {
     return changed;
 }
 
+// The principled BSDF's main parameters (Mitsuba's names); specular is shown as eta's other form.
+bool edit_bsdf(PrincipledBsdf& b) {
+    bool changed = reflectance("base color", b.base_color);
+    auto unit = [&](const char* label, float& v) { changed |= ImGui::SliderFloat(label, &v, 0.f, 1.f, "%.3f"); };
+    unit("roughness", b.roughness);
+    unit("metallic", b.metallic);
+    float specular = PrincipledBsdf::specular_from_eta(b.eta);
+    if (ImGui::SliderFloat("specular", &specular, 0.f, 1.f, "%.3f")) {
+        // Mitsuba keeps specular 0 (eta 1) away from a transmitting surface.
+        b.eta = PrincipledBsdf::eta_from_specular(std::max(specular, 1e-3f));
+        changed = true;
+    }
+    changed |= ior("eta", b.eta);
+    if (b.eta == 1.f) b.eta = 1.001f;
+    unit("spec tint", b.spec_tint);
+    unit("anisotropic", b.anisotropic);
+    unit("sheen", b.sheen);
+    unit("sheen tint", b.sheen_tint);
+    unit("clearcoat", b.clearcoat);
+    unit("clearcoat gloss", b.clearcoat_gloss);
+    if (ImGui::SliderFloat("spec trans", &b.spec_trans, 0.f, 1.f, "%.3f")) {
+        b.has_spec_trans = true;  // as Mitsuba's parameters_changed turns the lobe on
+        changed = true;
+    }
+    unit("flatness", b.flatness);
+    return changed;
+}
+
+const char* model_name(const PrincipledBsdf&) { return "principled"; }
+
 // Model names, recognised by their parameters as well (the variant may grow).
 template <class T>
 const char* model_name(const T&) {

@@ -6,10 +6,11 @@ namespace candela {
 namespace {
 
 // Mitsuba's BSDF::eval_diffuse_reflectance: the diffuse BSDF returns its reflectance; the others
-// (no override among the plugins candela has) return eval(wi, normal) * pi, i.e. f * cos * pi
-// towards the shading normal, which is 0 for delta lobes.
+// return eval(wi, normal) * pi, i.e. f * cos * pi towards the shading normal, which is 0 for delta
+// lobes; principled overrides it with its base colour, as Mitsuba's does.
 vec3 diffuse_reflectance(const Bsdf& bsdf, vec3 wo_local) {
     if (const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&bsdf)) return d->albedo;
+    if (const PrincipledBsdf* p = std::get_if<PrincipledBsdf>(&bsdf)) return p->base_color;
     return eval(bsdf, wo_local, vec3(0.f, 0.f, 1.f)) * kPi;
 }
 

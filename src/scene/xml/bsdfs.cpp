@@ -1,5 +1,6 @@
 // The bsdf family of the XML reader: Mitsuba 3's BSDF plugins as candela Materials.
 #include <algorithm>
+#include <cmath>
 #include "bsdf/fresnel.h"
 #include "bsdf/microfacet.h"
 #include "bsdf/named_conductors.h"
@@ -17,6 +18,7 @@ void set_field(Bsdf& b, vec3 v) { std::get<B>(b).*Field = v; }
 struct TexturableParam {
     const char* name;
     void (*apply)(Bsdf&, vec3);
+    bool scalar = false;  // a float parameter: the texture's eval_1 (alpha* are always scalar)
 };
 
 // The textures nested in a BSDF, each bound to the parameter it names; a texture for a parameter
@@ -27,7 +29,7 @@ Material with_textures(XmlLoader& L, Object& o, Material m, std::initializer_lis
     for (const TexturableParam& p : params)
         if (auto t = nested_texture(L, o, p.name)) {
             if (o.params.has(p.name)) throw o.params.error(p.name, std::string("'") + p.name + "' is given both as a value and as a texture");
-            const bool scalar = std::string(p.name).rfind("alpha", 0) == 0;  // a float parameter
+            const bool scalar = p.scalar || std::string(p.name).rfind("alpha", 0) == 0;  // a float parameter
             m.textures.push_back(TextureSlot{scalar ? as_float_texture(t) : t, p.apply, p.name});
         }
     for (const Nested& c : o.nested)
@@ -253,6 +255,71 @@ Material make_thindielectric(XmlLoader& L, Object& o) {
     return with_textures(L, o, Material{"", t, false}, {});
 }
 
+// ---- principled (Mitsuba 3.9's src/bsdfs/principled.cpp) ----------------------------------------
+template <float PrincipledBsdf::*Field>
+void set_principled(Bsdf& b, vec3 v) { std::get<PrincipledBsdf>(b).*Field = luminance(v); }
+
+// Mitsuba's get_flag: a lobe is on when its parameter is given as a texture or a float other than 0.
+bool principled_flag(XmlLoader& L, Object& o, const char* name) {
+    return has_texture_named(o, name, L) || (o.params.has(name) && o.params.get_float(name, 0.f) != 0.f);
+}
+
+Material make_principled(XmlLoader& L, Object& o) {
+    PrincipledBsdf p;
+    p.base_color = nonnegative_rgb(o, "base_color", vec3(0.5f));
+    auto unit = [&](const char* name, float def) {
+        const float v = o.params.get_float(name, def);
+        if (!(v >= 0.f && v <= 1.f)) throw o.params.error(name, std::string(name) + " must be in [0, 1]");
+        return v;
+    };
+    p.roughness = unit("roughness", 0.5f);
+    p.anisotropic = unit("anisotropic", 0.f);
+    p.metallic = unit("metallic", 0.f);
+    p.spec_tint = unit("spec_tint", 0.f);
+    p.sheen = unit("sheen", 0.f);
+    p.sheen_tint = unit("sheen_tint", 0.f);
+    p.clearcoat = unit("clearcoat", 0.f);
+    p.clearcoat_gloss = unit("clearcoat_gloss", 0.f);
+    p.spec_trans = unit("spec_trans", 0.f);
+    p.flatness = unit("flatness", 0.f);
+    p.has_spec_trans = principled_flag(L, o, "spec_trans");
+    auto rate = [&](const char* name) {
+        const float v = o.params.get_float(name, 1.f);
+        if (!(v >= 0.f) || !std::isfinite(v)) throw o.params.error(name, std::string(name) + " must not be negative");
+        return v;
+    };
+    p.main_specular_sampling_rate = rate("main_specular_sampling_rate");
+    p.clearcoat_sampling_rate = rate("clearcoat_sampling_rate");
+    p.diffuse_reflectance_sampling_rate = rate("diffuse_reflectance_sampling_rate");
+    // eta and specular are one parameter in two forms (Mitsuba refuses both); with a transmission
+    // lobe Mitsuba moves eta 1 to 1.001 and specular 0 to 1e-3 (eta 1 refracts nothing).
+    if (o.params.has("eta") && o.params.has("specular")) throw o.params.error("specular", "give either eta or specular, not both");
+    if (o.params.has("eta")) {
+        p.eta = o.params.get_float("eta", 1.5f);
+        if (!(p.eta > 0.f) || !std::isfinite(p.eta)) throw o.params.error("eta", "eta must be positive");
+        if (p.has_spec_trans && p.eta == 1.f) p.eta = 1.001f;
+    } else {
+        float s = o.params.get_float("specular", 0.5f);
+        if (!(s >= 0.f && s < 12.5f)) throw o.params.error("specular", "specular must be in [0, 12.5) (eta = 2 / (1 - sqrt(0.08 specular)) - 1)");
+        if (p.has_spec_trans && s == 0.f) s = 1e-3f;
+        p.eta = PrincipledBsdf::eta_from_specular(s);
+    }
+    // Mitsuba textures everything but eta, specular and the sampling rates.
+    using P = PrincipledBsdf;
+    return with_textures(L, o, Material{"", p, false},
+                         {{"base_color", set_field<P, &P::base_color>},
+                          {"roughness", set_principled<&P::roughness>, true},
+                          {"anisotropic", set_principled<&P::anisotropic>, true},
+                          {"metallic", set_principled<&P::metallic>, true},
+                          {"spec_tint", set_principled<&P::spec_tint>, true},
+                          {"sheen", set_principled<&P::sheen>, true},
+                          {"sheen_tint", set_principled<&P::sheen_tint>, true},
+                          {"clearcoat", set_principled<&P::clearcoat>, true},
+                          {"clearcoat_gloss", set_principled<&P::clearcoat_gloss>, true},
+                          {"spec_trans", set_principled<&P::spec_trans>, true},
+                          {"flatness", set_principled<&P::flatness>, true}});
+}
+
 Material make_twosided(XmlLoader& L, Object& o) {
     Material m = L.nested_bsdf(o);
     if (std::holds_alternative<DielectricBsdf>(m.bsdf))
@@ -274,6 +341,7 @@ const PluginTable<BsdfFactory>& bsdf_plugins() {
         {"dielectric", make_dielectric},
         {"roughdielectric", make_roughdielectric},
         {"thindielectric", make_thindielectric},
+        {"principled", make_principled},
         {"twosided", make_twosided},
         {"blendbsdf", blendbsdf_factory()},
         {"mask", mask_factory()},
