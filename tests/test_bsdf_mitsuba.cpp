@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "scene/loaders.h"
 #include "scene/scene.h"
+#include "support/bsdf_xml.h"
 #include "support/render.h"
 #include "support/run.h"
 #include "support/stats.h"
@@ -21,28 +22,11 @@ using namespace candela;
 
 namespace {
 
-std::string write_scene(const std::string& name, const std::string& bsdf_xml) {
-    const std::string path = candela::test::temp_dir("bsdf_mitsuba") + "/" + name + ".xml";
-    std::ofstream(path) << "<scene version=\"3.0.0\">\n<shape type=\"rectangle\">" << bsdf_xml << "</shape>\n</scene>\n";
-    return path;
-}
-
 Material load_material(const std::string& name, const std::string& bsdf_xml) {
-    SceneDescription s = load_mitsuba_xml(write_scene(name, bsdf_xml), {});
-    return s.materials[s.shapes.at(0).material];
+    return candela::test::load_bsdf_material("bsdf_mitsuba", name, bsdf_xml);
 }
-
 std::string load_error(const std::string& name, const std::string& bsdf_xml) {
-    const std::string path = write_scene(name, bsdf_xml);
-    try {
-        load_mitsuba_xml(path, {});
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        EXPECT_NE(msg.find(path + ":"), std::string::npos) << msg;  // file:line
-        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;  // one line
-        return msg;
-    }
-    return "<no error>";
+    return candela::test::load_bsdf_error("bsdf_mitsuba", name, bsdf_xml);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "scene/loaders.h"
 #include "scene/scene.h"
+#include "support/bsdf_xml.h"
 #include "support/render.h"
 #include "support/run.h"
 #include "support/stats.h"
@@ -23,28 +24,11 @@ namespace {
 
 constexpr double kAlpha = 0.01;  // family-wise significance of each TEST
 
-std::string write_scene(const std::string& name, const std::string& bsdf_xml) {
-    const std::string path = candela::test::temp_dir("principled") + "/" + name + ".xml";
-    std::ofstream(path) << "<scene version=\"3.0.0\">\n<shape type=\"rectangle\">" << bsdf_xml << "</shape>\n</scene>\n";
-    return path;
-}
-
 Material load_material(const std::string& name, const std::string& bsdf_xml) {
-    SceneDescription s = load_mitsuba_xml(write_scene(name, bsdf_xml), {});
-    return s.materials[s.shapes.at(0).material];
+    return candela::test::load_bsdf_material("principled", name, bsdf_xml);
 }
-
 std::string load_error(const std::string& name, const std::string& bsdf_xml) {
-    const std::string path = write_scene(name, bsdf_xml);
-    try {
-        load_mitsuba_xml(path, {});
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        EXPECT_NE(msg.find(path + ":"), std::string::npos) << msg;  // file:line
-        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;        // one line
-        return msg;
-    }
-    return "<no error>";
+    return candela::test::load_bsdf_error("principled", name, bsdf_xml);
 }
 
 vec3 dir(float cos_theta, float phi = 0.7f) {
