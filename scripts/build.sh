@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Configures and builds candela. Usage: bash scripts/build.sh [--sanitize] [--embree] [--debug]
-# Release build in build/ (ASan+UBSan build in build-asan/ with --sanitize).
+# Configures and builds candela. Usage: bash scripts/build.sh [--sanitize] [--embree] [--debug] [--mpi]
+# Release build in build/ (ASan+UBSan build in build-asan/ with --sanitize). MPI (CANDELA_MPI) is on
+# when Open MPI is installed; --mpi insists on it (an error without it), and the sanitizer and
+# Debug builds leave it off (Open MPI's own leaks are not ours; docs/distributed.md).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 dir=build
@@ -8,9 +10,10 @@ type=Release
 extra=()
 for a in "$@"; do
   case "$a" in
-    --sanitize) dir=build-asan; type=RelWithDebInfo; extra+=(-DCANDELA_SANITIZE=ON) ;;
+    --sanitize) dir=build-asan; type=RelWithDebInfo; extra+=(-DCANDELA_SANITIZE=ON -DCANDELA_MPI=OFF) ;;
     --embree) extra+=(-DCANDELA_EMBREE=ON) ;;
-    --debug) dir=build-debug; type=Debug ;;
+    --debug) dir=build-debug; type=Debug; extra+=(-DCANDELA_MPI=OFF) ;;
+    --mpi) extra+=(-DCANDELA_MPI=ON) ;;
     *) echo "build.sh: unknown option '$a'" >&2; exit 2 ;;
   esac
 done

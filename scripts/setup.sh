@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages candela needs. Idempotent: when everything is present it only
 # queries dpkg and returns; it runs `apt-get update` only when something is missing.
-# Usage: bash scripts/setup.sh [--with-embree] [--with-fuzz]   (--with-fuzz: clang and libFuzzer for scripts/fuzz.sh)
+# Usage: bash scripts/setup.sh [--with-embree] [--with-fuzz] [--with-mpi]
+#   --with-fuzz: clang and libFuzzer for scripts/fuzz.sh; --with-mpi: Open MPI for distributed
+#   rendering (docs/distributed.md; the build turns CANDELA_MPI on when it finds it)
 set -euo pipefail
 pkgs=(
   cmake ninja-build g++ pkg-config
@@ -14,6 +16,7 @@ for a in "$@"; do
   case "$a" in
     --with-embree) pkgs+=(libembree-dev) ;;
     --with-fuzz) pkgs+=(clang-14 libclang-rt-14-dev) ;;
+    --with-mpi) pkgs+=(libopenmpi-dev openmpi-bin) ;;
     *) echo "setup.sh: unknown option '$a'" >&2; exit 2 ;;
   esac
 done

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the tests under ctest.
 # Usage: bash scripts/test.sh [--debug | --sanitize | --tsan]
-#   (none)      the Release build in build/, every test
-#   --debug     the Debug build (-O0, assertions on) in build-debug/, every test but the heavy
+#   (none)      the Release build in build/ with MPI (Open MPI is installed for it), every test,
+#               the MPI ones (Mpi.*: mpirun -np 1, 2, 3 on this machine) included
+#   --debug     the Debug build (-O0, assertions on, MPI off) in build-debug/, every test but the heavy
 #               statistical and brute-force ones, which at -O0 run 10-30x their Release time
 #               (the chi-square tests, the image and furnace tests, brute-force accelerator
 #               comparisons): they check numbers, which Release and ASan already cover, where a
 #               Debug run is for assertions and code that -O3 could hide. CANDELA_DEBUG_EXCLUDE=REGEX
 #               replaces the regex (an empty value runs everything). See docs/reliability.md.
-#   --sanitize  the ASan+UBSan build in build-asan/, every test (about 7x the Release suite's CPU
+#   --sanitize  the ASan+UBSan build in build-asan/ (MPI off: Open MPI's own leaks are not ours),
+#               every test (about 7x the Release suite's CPU
 #               time, see docs/reliability.md); CANDELA_ASAN_EXCLUDE=REGEX leaves tests out
 #               (ctest -E), e.g. '^(BsdfChi2|ImageCornell|KdTree)\.' for a quick local run
 #   --tsan      a ThreadSanitizer build in build-tsan/, the render session and the viewer's use of it
@@ -18,11 +20,11 @@
 #               threads (worker and front end) to check. See docs/reliability.md.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-bash scripts/setup.sh
 mode=${1:-}
+if [ -z "$mode" ]; then bash scripts/setup.sh --with-mpi; else bash scripts/setup.sh; fi
 case "$mode" in
   "")
-    dir=$(bash scripts/build.sh | tail -n 1)
+    dir=$(bash scripts/build.sh --mpi | tail -n 1)
     cd "$dir"
     ctest --output-on-failure -j"$(nproc)" --timeout 600
     ;;
@@ -50,7 +52,7 @@ case "$mode" in
     ;;
   --tsan)
     if [ ! -f build-tsan/build.ninja ]; then
-      cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCANDELA_VIEWER=OFF -DCANDELA_BENCH=OFF \
+      cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCANDELA_VIEWER=OFF -DCANDELA_BENCH=OFF -DCANDELA_MPI=OFF \
         -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" >/dev/null
     fi
     cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2

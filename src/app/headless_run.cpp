@@ -54,15 +54,6 @@ void install_signal_handlers() {
     sigaction(SIGTERM, &sa, nullptr);
 }
 
-// Refuses an output whose directory is missing or not writable before rendering, not hours later.
-void check_writable(const std::string& path) {
-    std::string dir = std::filesystem::path(path).parent_path().string();
-    if (dir.empty()) dir = ".";
-    std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec)) throw Error(path, 0, "directory '" + dir + "' does not exist");
-    if (::access(dir.c_str(), W_OK) != 0) throw Error(path, 0, "cannot write in directory '" + dir + "'");
-}
-
 // Cuts the pass in flight at the deadline: sets `stop` (the pass's cancel flag, polled per tile)
 // and `fired`. Between passes the loop checks the clock itself.
 class Deadline {
@@ -94,6 +85,60 @@ private:
 };
 
 }  // namespace
+
+// Refuses an output whose directory is missing or not writable before rendering, not hours later.
+void check_writable(const std::string& path) {
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec)) throw Error(path, 0, "directory '" + dir + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0) throw Error(path, 0, "cannot write in directory '" + dir + "'");
+}
+
+WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene, const Film& film) {
+    const std::string ext = file_extension(opt.out);
+    const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
+    WrittenImage out{opt.out, false};
+    Image img{film.width(), film.height(), film.resolve(), {}};
+    if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
+    if (!aovs.empty() && ext == ".exr") {
+        std::vector<std::string> names = aov_channel_names(aovs);
+        std::vector<std::vector<float>> planes = film.resolve_aovs();
+        std::vector<ExrLayer> layers;
+        for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
+        write_exr_layers(opt.out, img, layers);
+    } else if (ext == ".png") {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
+        // The PNG goes through GL; if that fails the samples must not go with it.
+        try {
+            write_png_headless(opt.out, img, opt.display);
+        } catch (const std::exception& e) {
+            out.png_failed = true;
+            out.path = std::filesystem::path(opt.out).replace_extension(".exr").string();
+            std::fprintf(stderr, "candela: %s\n", e.what());
+            if (film.has_alpha()) img.alpha = film.resolve_alpha();
+            write_linear_image(out.path, img);
+            std::fprintf(stderr, "candela: %s not written; the image is in %s (linear EXR) instead\n",
+                         opt.out.c_str(), out.path.c_str());
+        }
+    } else {
+        if (!aovs.empty() && !opt.quiet)
+            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                         opt.out.c_str());
+        write_linear_image(opt.out, img);
+    }
+    return out;
+}
+
+void print_memory_summary(const Scene& scene) {
+    const Scene::Memory mem = scene.memory();
+    const double per_tri = mem.triangles ? 1.0 / double(mem.triangles) : 0.0;
+    std::fprintf(stderr, "candela: %zu triangles, %.1f MB (%.1f B/triangle: mesh %.1f, accel %.1f, lights %.1f)\n",
+                 mem.triangles, double(mem.total()) / 1e6, double(mem.total()) * per_tri, double(mem.mesh) * per_tri,
+                 double(mem.accel) * per_tri, double(mem.lights) * per_tri);
+}
 
 int run_headless(const HeadlessOptions& opt) {
     std::string ext = file_extension(opt.out);
@@ -235,49 +280,15 @@ int run_headless(const HeadlessOptions& opt) {
     }
     if (checkpointing && whole_passes) save("final");
 
-    Image img{film.width(), film.height(), film.resolve(), {}};
-    if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
-    std::string written = opt.out;
-    bool png_failed = false;
-    if (!aovs.empty() && ext == ".exr") {
-        std::vector<std::string> names = aov_channel_names(aovs);
-        std::vector<std::vector<float>> planes = film.resolve_aovs();
-        std::vector<ExrLayer> layers;
-        for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
-        write_exr_layers(opt.out, img, layers);
-    } else if (ext == ".png") {
-        if (!aovs.empty() && !opt.quiet)
-            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
-                         opt.out.c_str());
-        // The PNG goes through GL; if that fails the samples must not go with it.
-        try {
-            write_png_headless(opt.out, img, opt.display);
-        } catch (const std::exception& e) {
-            png_failed = true;
-            written = std::filesystem::path(opt.out).replace_extension(".exr").string();
-            std::fprintf(stderr, "candela: %s\n", e.what());
-            if (film.has_alpha()) img.alpha = film.resolve_alpha();
-            write_linear_image(written, img);
-            std::fprintf(stderr, "candela: %s not written; the image is in %s (linear EXR) instead\n",
-                         opt.out.c_str(), written.c_str());
-        }
-    } else {
-        if (!aovs.empty() && !opt.quiet)
-            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
-                         opt.out.c_str());
-        write_linear_image(opt.out, img);
-    }
+    const WrittenImage wi = write_headless_image(opt, scene, film);
+    const std::string& written = wi.path;
+    const bool png_failed = wi.png_failed;
 
     const int sig = g_signal.load();
     if (!opt.quiet) {
         double spp = double(film.total_samples()) / (double(film.width()) * film.height());
         // Memory first: scripts read the summary from the last line.
-        const Scene::Memory mem = scene.memory();
-        const double per_tri = mem.triangles ? 1.0 / double(mem.triangles) : 0.0;
-        std::fprintf(stderr,
-                     "candela: %zu triangles, %.1f MB (%.1f B/triangle: mesh %.1f, accel %.1f, lights %.1f)\n",
-                     mem.triangles, double(mem.total()) / 1e6, double(mem.total()) * per_tri,
-                     double(mem.mesh) * per_tri, double(mem.accel) * per_tri, double(mem.lights) * per_tri);
+        print_memory_summary(scene);
         std::fprintf(stderr,
                      "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",

@@ -1,7 +1,9 @@
 #pragma once
 #include <string>
 #include "display/display.h"
+#include "film/film.h"
 #include "render/launch.h"
+#include "scene/scene.h"
 
 namespace candela {
 
@@ -28,5 +30,18 @@ struct HeadlessOptions {
 // finish (a checkpoint holds whole passes) and a second one stops at once. Returns the process
 // exit code: 0, or 128 + the signal's number when stopped by one.
 int run_headless(const HeadlessOptions& opt);
+
+// Pieces of run_headless that the MPI run (app/mpi_run.h) shares.
+// Refuses an output whose directory is missing or not writable (Error naming the file).
+void check_writable(const std::string& path);
+// Writes the film to opt.out: PNG through the display shaders (a linear EXR beside it if GL
+// fails), EXR (with the AOV layers), or PFM. Returns the file written and whether the PNG failed.
+struct WrittenImage {
+    std::string path;
+    bool png_failed = false;
+};
+WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene, const Film& film);
+// The summary line of the scene's memory (triangles, MB, bytes per triangle).
+void print_memory_summary(const Scene& scene);
 
 }  // namespace candela

@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include "app/headless_run.h"
 #include "core/error.h"
+#ifdef CANDELA_HAS_MPI
+#include "app/mpi_run.h"
+#endif
 #ifdef CANDELA_HAS_VIEWER
 #include "viewer/viewer.h"
 #endif
@@ -86,6 +89,10 @@ int main(int argc, char** argv) {
         if (*s_opt) ov.seed = seed;
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
 
+#ifdef CANDELA_HAS_MPI
+        // Under mpirun or srun every rank renders a share of one headless render.
+        if (launched_by_mpi()) return run_headless_mpi(opt);
+#endif
         bool has_display = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
         std::string why_headless = has_display ? "built without the viewer" : "no display";
 #ifdef CANDELA_HAS_VIEWER

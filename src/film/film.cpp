@@ -63,6 +63,24 @@ void Film::merge(const FilmTile& t) {
         }
 }
 
+void Film::add(const Film& o) {
+    const size_t n = sum_.size();
+    for (size_t i = 0; i < n; ++i) {
+        sum_[i] += o.sum_[i];
+        count_[i] += o.count_[i];
+    }
+    if (weighted_)
+        for (size_t i = 0; i < n; ++i) weight_[i] += o.weight_[i];
+    for (size_t i = 0; i < aov_.size(); ++i) aov_[i] += o.aov_[i];
+    if (alpha_enabled_ && o.alpha_enabled_)
+        for (size_t i = 0; i < n; ++i) alpha_[i] += o.alpha_[i];
+    if (!o.splat_.empty()) {
+        if (splat_.empty()) splat_.assign(n, dvec3(0.0));
+        for (size_t i = 0; i < n; ++i) splat_[i] += o.splat_[i];
+    }
+    nonfinite_.fetch_add(o.nonfinite_count(), std::memory_order_relaxed);
+}
+
 void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int margin) {
     x0 = std::max(0, tx0 - margin);
     y0 = std::max(0, ty0 - margin);

@@ -58,6 +58,12 @@ public:
     void count_nonfinite() { nonfinite_.fetch_add(1, std::memory_order_relaxed); }
     // Weighted layout: adds a tile's sums into the film. Call from one thread, tiles in a fixed order.
     void merge(const FilmTile& tile);
+    // Adds another film of the same size and layout, pixel by pixel: sums, weights, counts, AOVs,
+    // alpha, splats and the non-finite count. A weighted pass merges each sample index's tiles into
+    // a zeroed layer and adds the layer with this, so the film is always the sum, in sample order,
+    // of per-sample-index layers: MPI ranks ship such layers and rank 0 adds them in the same order
+    // (docs/distributed.md), which makes its image the single-process one bit for bit.
+    void add(const Film& other);
     // Alpha (hdrfilm pixel_format rgba): per pixel, the fraction of its samples whose camera ray
     // hit a surface, as Mitsuba. Off (and not allocated) until enable_alpha; kept over resize.
     void enable_alpha();
@@ -93,6 +99,10 @@ public:
     const std::vector<dvec3>& sums() const { return sum_; }
     const std::vector<uint32_t>& counts() const { return count_; }
     const std::vector<double>& weights() const { return weight_; }  // weighted layout only
+    const std::vector<double>& aov_sums() const { return aov_; }   // aov_channels per pixel
+    const std::vector<dvec3>& splats() const { return splat_; }    // empty until a splat
+    void restore_aov(std::vector<double> sums) { aov_ = std::move(sums); }
+    void restore_splats(std::vector<dvec3> splats) { splat_ = std::move(splats); }
     // `weights` must be empty for an unweighted film and one per pixel for a weighted one.
     void restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite,
                  std::vector<double> weights = {});

@@ -9,10 +9,10 @@
 // writes, in sample order: the plain loop of before, at its speed.
 // Other filters (the film weighted): a sample splats into every pixel within the filter's radius,
 // also across tiles. Each tile accumulates into its own FilmTile (the tile plus the filter's
-// reach), and after all tiles the FilmTiles are merged into the film in tile order. The pass runs
-// one sample index at a time (all tiles for index s, merge, then s + 1), so the additions into a
-// pixel happen in the order (sample index, tile, pixel), whatever the thread count and whatever
-// the split of the samples into passes: the image is the same bit for bit.
+// reach); after all tiles the FilmTiles are merged in tile order into a zeroed layer, which is then
+// added to the film (Film::add). The pass runs one sample index at a time (all tiles for index s,
+// merge, add, then s + 1), so the film is the sum in index order of per-index layers, whatever the
+// thread count and the split of the samples into passes: the image is the same bit for bit.
 // AOVs (the aov wrapper): computed for the camera ray before `li` runs, filtered the same way;
 // the moment wrapper's channels from the sample's radiance after it.
 #include <omp.h>
@@ -134,6 +134,9 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
         const PixelFilter filter(scene.settings.filter);
         std::vector<FilmTile> tiles(static_cast<size_t>(n_tiles));
         std::vector<char> done(static_cast<size_t>(n_tiles));
+        Film layer(w, h);
+        layer.set_layout(true, n_aov);
+        if (alpha) layer.enable_alpha();
         for (int s = 0; s < spp && !cancelled(); ++s) {
             std::fill(done.begin(), done.end(), 0);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
@@ -170,8 +173,13 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                 total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
                 total_samples.fetch_add(samples, std::memory_order_relaxed);
             }
+            // The tiles of index s go into a zeroed layer, which is then added to the film: the
+            // film is the sum of per-index layers in index order, what an MPI rank 0 can rebuild
+            // from layers rendered elsewhere (Film::add).
+            layer.clear();
             for (int tile = 0; tile < n_tiles; ++tile)
-                if (done[size_t(tile)]) film.merge(tiles[size_t(tile)]);
+                if (done[size_t(tile)]) layer.merge(tiles[size_t(tile)]);
+            film.add(layer);
         }
     }
     PassStats out;
