@@ -127,9 +127,11 @@ LayerHeader unpack_layer(const std::vector<char>& b, Film& f) {
     return h;
 }
 
-// CANDELA_MPI_TEST_SLOW_RANK=r:ms (for the load-balance test): rank r sleeps ms per chunk.
-int slow_ms_for(int rank) {
-    const char* v = std::getenv("CANDELA_MPI_TEST_SLOW_RANK");
+// Test hooks, "r:n" in the environment: CANDELA_MPI_TEST_SLOW_RANK (rank r sleeps n ms per chunk,
+// for the load-balance test) and CANDELA_MPI_TEST_DIE_RANK (rank r kills itself with SIGKILL when
+// given its n-th chunk, for the failure test). 0 when unset or for another rank.
+int test_hook(const char* name, int rank) {
+    const char* v = std::getenv(name);
     if (!v) return 0;
     int r = -1, ms = 0;
     if (std::sscanf(v, "%d:%d", &r, &ms) != 2 || r != rank) return 0;
@@ -318,13 +320,15 @@ int run_headless_mpi(const HeadlessOptions& opt) {
         for (const std::string& w : scene.warnings) std::fprintf(stderr, "candela: warning: %s\n", w.c_str());
         if (!opt.resume.empty()) std::fprintf(stderr, "candela: resuming %s at %u spp\n", opt.resume.c_str(), start);
     }
-    const int slow_ms = slow_ms_for(rank);
+    const int slow_ms = test_hook("CANDELA_MPI_TEST_SLOW_RANK", rank);
+    const int die_at = test_hook("CANDELA_MPI_TEST_DIE_RANK", rank);
     auto slow_down = [&] {
         if (slow_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(slow_ms));
     };
 
     // ---- a worker: ask, render, send, until rank 0 says there is nothing left -------------------
     if (rank != 0) {
+        int chunks_taken = 0;
         try {
             for (;;) {
                 const int sig = g_signal.load();
@@ -342,6 +346,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
                     break;
                 }
                 if (a[1] == 0) break;
+                if (die_at > 0 && ++chunks_taken == die_at) raise(SIGKILL);
                 std::atomic<bool> cancel{g_signal.load() != 0}, done{false};
                 std::vector<std::vector<char>> out;
                 std::exception_ptr failure;

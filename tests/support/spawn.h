@@ -12,11 +12,11 @@ namespace candela::test {
 
 // `candela args` running in the background with stdout and stderr going to a log file. The shell
 // execs env, which execs candela, so `pid` is candela's own: a signal sent to it reaches the
-// renderer.
+// renderer. `program` replaces candela (the MPI tests run mpirun, whose args name candela).
 class Child {
 public:
-    Child(const std::string& args, const std::string& log) {
-        std::string cmd = std::string("exec env -u DISPLAY -u WAYLAND_DISPLAY ") + CANDELA_BIN + " " + args + " >'" +
+    Child(const std::string& args, const std::string& log, const std::string& program = CANDELA_BIN) {
+        std::string cmd = std::string("exec env -u DISPLAY -u WAYLAND_DISPLAY ") + program + " " + args + " >'" +
                           log + "' 2>&1";
         pid_ = fork();
         if (pid_ == 0) {
