@@ -73,14 +73,6 @@ void put(std::vector<char>& b, const std::vector<T>& v) {
     if (!v.empty()) std::memcpy(b.data() + at, v.data(), v.size() * sizeof(T));
 }
 
-template <class T>
-void get(const char*& p, const char* end, std::vector<T>& v, size_t n) {
-    if (size_t(end - p) < n * sizeof(T)) throw Error("internal error: a short MPI layer message");
-    v.resize(n);
-    if (n) std::memcpy(v.data(), p, n * sizeof(T));
-    p += n * sizeof(T);
-}
-
 // A layer is a whole film of the render's layout (doubles: 24 B of sums and 4 B of counts per
 // pixel, plus weights, AOVs and alpha where the scene has them).
 std::vector<char> pack_layer(const Film& f, uint32_t index, const PassStats& ps) {
@@ -93,38 +85,49 @@ std::vector<char> pack_layer(const Film& f, uint32_t index, const PassStats& ps)
     h.has_splats = f.splats().empty() ? 0 : 1;
     std::vector<char> b(sizeof h);
     std::memcpy(b.data(), &h, sizeof h);
-    put(b, f.sums());
-    put(b, f.counts());
+    put(b, f.sums());  // the doubles first, so that they are aligned when read in place
     if (f.weighted()) put(b, f.weights());
     put(b, f.aov_sums());
     if (f.has_alpha()) put(b, f.alpha_sums());
     if (h.has_splats) put(b, f.splats());
+    put(b, f.counts());
     if (b.size() > size_t(INT_MAX)) throw Error("the image is too large for one MPI message (2 GB): render it in crops");
     return b;
 }
 
-LayerHeader unpack_layer(const std::vector<char>& b, Film& f) {
+// A received layer message, its arrays read in place (pack_layer's order; the buffer stays owned
+// by the message).
+struct LayerView {
     LayerHeader h;
-    if (b.size() < sizeof h) throw Error("internal error: a short MPI layer message");
-    std::memcpy(&h, b.data(), sizeof h);
-    const char* p = b.data() + sizeof h;
+    const dvec3* sums = nullptr;
+    const double *weights = nullptr, *aov = nullptr, *alpha = nullptr;
+    const dvec3* splats = nullptr;
+    const uint32_t* counts = nullptr;
+};
+
+template <class T>
+const T* take(const char*& p, const char* end, size_t n) {
+    if (size_t(end - p) < n * sizeof(T)) throw Error("internal error: a short MPI layer message");
+    const T* v = reinterpret_cast<const T*>(p);
+    p += n * sizeof(T);
+    return v;
+}
+
+LayerView view_layer(const std::vector<char>& b, const Film& like) {
+    LayerView v;
+    if (b.size() < sizeof v.h) throw Error("internal error: a short MPI layer message");
+    std::memcpy(&v.h, b.data(), sizeof v.h);
+    const char* p = b.data() + sizeof v.h;
     const char* end = b.data() + b.size();
-    const size_t n = size_t(f.width()) * size_t(f.height());
-    std::vector<dvec3> sums, splats;
-    std::vector<uint32_t> counts;
-    std::vector<double> weights, aov, alpha;
-    get(p, end, sums, n);
-    get(p, end, counts, n);
-    if (f.weighted()) get(p, end, weights, n);
-    get(p, end, aov, n * size_t(f.aov_channels()));
-    if (f.has_alpha()) get(p, end, alpha, n);
-    if (h.has_splats) get(p, end, splats, n);
+    const size_t n = size_t(like.width()) * size_t(like.height());
+    v.sums = take<dvec3>(p, end, n);
+    if (like.weighted()) v.weights = take<double>(p, end, n);
+    v.aov = take<double>(p, end, n * size_t(like.aov_channels()));
+    if (like.has_alpha()) v.alpha = take<double>(p, end, n);
+    if (v.h.has_splats) v.splats = take<dvec3>(p, end, n);
+    v.counts = take<uint32_t>(p, end, n);
     if (p != end) throw Error("internal error: an MPI layer message of the wrong size (do the ranks run the same build?)");
-    f.restore(std::move(sums), std::move(counts), h.nonfinite, std::move(weights));
-    f.restore_aov(std::move(aov));
-    if (f.has_alpha()) f.restore_alpha(std::move(alpha));
-    f.restore_splats(std::move(splats));
-    return h;
+    return v;
 }
 
 // Test hooks, "r:n" in the environment: CANDELA_MPI_TEST_SLOW_RANK (rank r sleeps n ms per chunk,
@@ -138,6 +141,20 @@ int test_hook(const char* name, int rank) {
     return std::max(0, ms);
 }
 
+// A layer on rank 0: rendered there (a film) or received (the message, read in place).
+struct Layer {
+    std::unique_ptr<Film> film;
+    std::vector<char> bytes;
+    void add_to(Film& total) const {
+        if (film) {
+            total.add(*film);
+            return;
+        }
+        const LayerView v = view_layer(bytes, total);
+        total.add(v.sums, v.counts, v.weights, v.aov, v.alpha, v.splats, v.h.nonfinite);
+    }
+};
+
 // Rank 0's film: the layers added in sample-index order. Layers that arrive before their turn wait
 // in `early`; layers cut by a stop wait in `cut` and are added at the end (after the checkpoint,
 // which must hold whole sample indices). Guarded by `m`.
@@ -145,12 +162,12 @@ struct Reducer {
     std::mutex m;
     Film* total = nullptr;
     uint32_t next = 0;  // total holds sample indices [0, next) of every pixel
-    std::map<uint32_t, std::unique_ptr<Film>> early;
-    std::vector<std::pair<uint32_t, std::unique_ptr<Film>>> cut;
+    std::map<uint32_t, Layer> early;
+    std::vector<std::pair<uint32_t, Layer>> cut;
     uint64_t samples = 0, rays = 0, layers = 0;
     double add_seconds = 0;  // time spent adding layers (the reduction's cost on rank 0)
 
-    void deliver(uint32_t index, bool complete, std::unique_ptr<Film> layer, uint64_t s, uint64_t r) {
+    void deliver(uint32_t index, bool complete, Layer layer, uint64_t s, uint64_t r) {
         std::lock_guard<std::mutex> lock(m);
         samples += s;
         rays += r;
@@ -164,10 +181,10 @@ struct Reducer {
             return;
         }
         const auto t0 = std::chrono::steady_clock::now();
-        total->add(*layer);
+        layer.add_to(*total);
         ++next;
         for (auto it = early.begin(); it != early.end() && it->first == next; it = early.erase(it)) {
-            total->add(*it->second);
+            it->second.add_to(*total);
             ++next;
         }
         add_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -175,10 +192,10 @@ struct Reducer {
     // Everything into the film, in index order: the image of a stopped render.
     void finish() {
         std::lock_guard<std::mutex> lock(m);
-        for (auto& [i, f] : early) total->add(*f);
+        for (auto& [i, l] : early) l.add_to(*total);
         early.clear();
         std::sort(cut.begin(), cut.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-        for (auto& [i, f] : cut) total->add(*f);
+        for (auto& [i, l] : cut) l.add_to(*total);
         cut.clear();
     }
 };
@@ -406,7 +423,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
                 slow_down();
                 render_chunk(scene, first, count, threads, cancel, make_film,
                              [&](uint32_t s, std::unique_ptr<Film> layer, const PassStats& ps) {
-                                 red.deliver(s, ps.completed, std::move(layer), ps.samples, ps.rays);
+                                 red.deliver(s, ps.completed, Layer{std::move(layer), {}}, ps.samples, ps.rays);
                              });
                 if (cancel) break;
             }
@@ -436,7 +453,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
     bool stopping = false, time_up = false;
     int stop_signal = 0;  // the signal that stopped the render (this rank's or a worker's)
     uint64_t bytes_received = 0, messages = 0;
-    double unpack_seconds = 0;
+    double recv_seconds = 0;
     auto stop_all = [&] {
         if (stopping) return;
         stopping = true;
@@ -458,15 +475,14 @@ int run_headless_mpi(const HeadlessOptions& opt) {
                 if (status.MPI_TAG == kLayer) {
                     int bytes = 0;
                     MPI_Get_count(&status, MPI_BYTE, &bytes);
+                    const auto u0 = clock::now();
                     std::vector<char> b(size_t(std::max(0, bytes)));
                     MPI_Recv(b.data(), bytes, MPI_BYTE, src, kLayer, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                    const auto u0 = clock::now();
-                    std::unique_ptr<Film> layer = make_film();
-                    const LayerHeader h = unpack_layer(b, *layer);
-                    unpack_seconds += std::chrono::duration<double>(clock::now() - u0).count();
+                    const LayerHeader h = view_layer(b, *film).h;  // checks the size
+                    recv_seconds += std::chrono::duration<double>(clock::now() - u0).count();
                     bytes_received += uint64_t(bytes);
                     ++messages;
-                    red.deliver(h.index, h.complete != 0, std::move(layer), h.samples, h.rays);
+                    red.deliver(h.index, h.complete != 0, Layer{nullptr, std::move(b)}, h.samples, h.rays);
                 } else if (status.MPI_TAG == kRequest) {
                     int32_t req = 0;
                     MPI_Recv(&req, 1, MPI_INT32_T, src, kRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
@@ -568,9 +584,9 @@ int run_headless_mpi(const HeadlessOptions& opt) {
         for (uint64_t c : disp.chunks_per_rank) per_rank += (per_rank.empty() ? "" : " ") + std::to_string(c);
         std::fprintf(stderr,
                      "candela: mpi: %d ranks x %d threads; chunks of %u spp per rank: %s; rank 0 received %.1f MB in "
-                     "%llu layers, %.3f s unpacking and %.3f s adding\n",
+                     "%llu layers, %.3f s receiving and %.3f s adding\n",
                      size, threads, chunk, per_rank.c_str(), double(bytes_received) / 1e6, (unsigned long long)messages,
-                     unpack_seconds, red.add_seconds);
+                     recv_seconds, red.add_seconds);
         std::fprintf(stderr,
                      "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d ranks x %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",

@@ -64,21 +64,27 @@ void Film::merge(const FilmTile& t) {
 }
 
 void Film::add(const Film& o) {
+    add(o.sum_.data(), o.count_.data(), o.weight_.data(), o.aov_.data(), o.alpha_enabled_ ? o.alpha_.data() : nullptr,
+        o.splat_.empty() ? nullptr : o.splat_.data(), o.nonfinite_count());
+}
+
+void Film::add(const dvec3* sums, const uint32_t* counts, const double* weights, const double* aov,
+               const double* alpha, const dvec3* splats, uint64_t nonfinite) {
     const size_t n = sum_.size();
     for (size_t i = 0; i < n; ++i) {
-        sum_[i] += o.sum_[i];
-        count_[i] += o.count_[i];
+        sum_[i] += sums[i];
+        count_[i] += counts[i];
     }
     if (weighted_)
-        for (size_t i = 0; i < n; ++i) weight_[i] += o.weight_[i];
-    for (size_t i = 0; i < aov_.size(); ++i) aov_[i] += o.aov_[i];
-    if (alpha_enabled_ && o.alpha_enabled_)
-        for (size_t i = 0; i < n; ++i) alpha_[i] += o.alpha_[i];
-    if (!o.splat_.empty()) {
+        for (size_t i = 0; i < n; ++i) weight_[i] += weights[i];
+    for (size_t i = 0; i < aov_.size(); ++i) aov_[i] += aov[i];
+    if (alpha_enabled_ && alpha)
+        for (size_t i = 0; i < n; ++i) alpha_[i] += alpha[i];
+    if (splats) {
         if (splat_.empty()) splat_.assign(n, dvec3(0.0));
-        for (size_t i = 0; i < n; ++i) splat_[i] += o.splat_[i];
+        for (size_t i = 0; i < n; ++i) splat_[i] += splats[i];
     }
-    nonfinite_.fetch_add(o.nonfinite_count(), std::memory_order_relaxed);
+    nonfinite_.fetch_add(nonfinite, std::memory_order_relaxed);
 }
 
 void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int margin) {

@@ -64,6 +64,11 @@ public:
     // of per-sample-index layers: MPI ranks ship such layers and rank 0 adds them in the same order
     // (docs/distributed.md), which makes its image the single-process one bit for bit.
     void add(const Film& other);
+    // The same from raw arrays of a film of this size and layout (an MPI layer message read in
+    // place): `weights` when weighted, `aov` when aov_channels > 0, `alpha` when alpha is on;
+    // `splats` may be null (none).
+    void add(const dvec3* sums, const uint32_t* counts, const double* weights, const double* aov, const double* alpha,
+             const dvec3* splats, uint64_t nonfinite);
     // Alpha (hdrfilm pixel_format rgba): per pixel, the fraction of its samples whose camera ray
     // hit a surface, as Mitsuba. Off (and not allocated) until enable_alpha; kept over resize.
     void enable_alpha();
