@@ -17,7 +17,9 @@ using namespace candela;
 int main(int argc, char** argv) {
     CLI::App app{"candela: an interactive, progressive path tracer for the CPU.\n"
                  "With no SCENE it renders the built-in Cornell box. With --out it renders headless;\n"
-                 "otherwise it opens the viewer when a display is available."};
+                 "otherwise it opens the viewer when a display is available.\n"
+                 "Under mpirun or srun (built with MPI) the ranks share one headless render; rank 0 writes\n"
+                 "the image, which equals the one-process image bit for bit (docs/distributed.md)."};
     HeadlessOptions opt;
     SceneOverrides& ov = opt.overrides;
     std::vector<std::string> defines;
