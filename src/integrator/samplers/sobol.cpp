@@ -1,0 +1,10 @@
+// The path and direct passes with the sobol sampler: their own translation unit (integrator/sampled_pass.h).
+#include "integrator/sampled_pass.h"
+
+namespace candela {
+
+template PassStats render_pass_for<PathIntegrator, SobolSampler>(const Scene&, Film&, uint32_t, int, int, const std::atomic<bool>*);
+template PassStats render_pass_for<DirectIntegrator, SobolSampler>(const Scene&, Film&, uint32_t, int, int,
+                                                         const std::atomic<bool>*);
+
+}  // namespace candela
