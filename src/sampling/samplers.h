@@ -99,16 +99,26 @@ protected:
         key_ = hash_combine(sampler_detail::pixel_key(pixel), seed_);
         index_ = sample_index;
         dim_ = 0;
-        rng_.set_sequence(key_, mix_bits(seed_ ^ 0x5bd1e995ULL));
-        rng_.advance(uint64_t(sample_index) << 16);
+        rng_ready_ = false;
+    }
+    // The pixel's independent stream at this sample, set up on first use (the Sobol samplers
+    // rarely need it).
+    PCG32& rng() {
+        if (!rng_ready_) {
+            rng_.set_sequence(key_, mix_bits(seed_ ^ 0x5bd1e995ULL));
+            rng_.advance(uint64_t(index_) << 16);
+            rng_ready_ = true;
+        }
+        return rng_;
     }
     // A seed for dimension dim_ of set `set` of this pixel, then the next dimension.
     uint32_t next_dim_seed(uint32_t set) {
-        return uint32_t(hash_combine(key_, (uint64_t(set) << 32) | dim_++) >> 16);
+        return uint32_t(mix_bits(key_ ^ (((uint64_t(set) << 32) | dim_++) * 0x9e3779b97f4a7c15ULL)) >> 16);
     }
     uint64_t seed_;
     uint64_t key_ = 0;
     uint32_t index_ = 0, dim_ = 0;
+    bool rng_ready_ = false;
     PCG32 rng_;
 };
 
@@ -141,7 +151,7 @@ public:
     }
 
 private:
-    float jit() { return jitter_ ? rng_.next_float() : 0.5f; }
+    float jit() { return jitter_ ? rng().next_float() : 0.5f; }
     bool jitter_;
     uint32_t n_, res_ = 1, set_ = 0, member_ = 0;
 };
@@ -181,7 +191,7 @@ public:
     }
 
 private:
-    float jit() { return jitter_ ? rng_.next_float() : 0.5f; }
+    float jit() { return jitter_ ? rng().next_float() : 0.5f; }
     bool jitter_;
     uint32_t n_, a_ = 1, b_ = 1, set_ = 0, member_ = 0;
 };
@@ -225,15 +235,15 @@ public:
     explicit SobolSampler(const SamplerSetup& s) : PixelSampleBase(s.seed) {}
     void start_pixel_sample(ivec2 pixel, uint32_t i) { start(pixel, i); }
     float next_1d() {
-        if (dim_ >= uint32_t(kSobolDimensions)) return rng_.next_float();
+        if (dim_ >= uint32_t(kSobolDimensions)) return rng().next_float();
         const int d = int(dim_);
         return bits_to_unit(owen_scramble(sobol_bits(index_, d), next_dim_seed(0)));
     }
     vec2 next_2d() {
         if (dim_ + 2 > uint32_t(kSobolDimensions)) {
             dim_ = uint32_t(kSobolDimensions);  // the budget is spent: no later draw goes back to Sobol
-            const float a = rng_.next_float();
-            return vec2(a, rng_.next_float());
+            const float a = rng().next_float();
+            return vec2(a, rng().next_float());
         }
         const int d = int(dim_);
         const float x = bits_to_unit(owen_scramble(sobol_bits(index_, d), next_dim_seed(0)));
@@ -268,17 +278,18 @@ public:
         base_ = (set << bits_) | (sampler_detail::morton2(pixel) << log2_spp_) | low;
     }
     float next_1d() {
-        const uint64_t h = hash_combine(salt_, dim_);
+        const uint64_t h = mix_bits(salt_ ^ (uint64_t(dim_) * 0x9e3779b97f4a7c15ULL));
         const uint64_t idx = permuted(h);
         ++dim_;
         return bits_to_unit(owen_scramble(sobol_bits(idx, 0), uint32_t(h)));
     }
     vec2 next_2d() {
-        const uint64_t h = hash_combine(salt_, dim_);
+        const uint64_t h = mix_bits(salt_ ^ (uint64_t(dim_) * 0x9e3779b97f4a7c15ULL));
         const uint64_t idx = permuted(h);
         ++dim_;
-        return vec2(bits_to_unit(owen_scramble(sobol_bits(idx, 0), uint32_t(h))),
-                    bits_to_unit(owen_scramble(sobol_bits(idx, 1), uint32_t(h >> 32))));
+        uint32_t x, y;
+        sobol_bits_01(idx, x, y);
+        return vec2(bits_to_unit(owen_scramble(x, uint32_t(h))), bits_to_unit(owen_scramble(y, uint32_t(h >> 32))));
     }
 
 private:
@@ -296,7 +307,9 @@ private:
             const int width = (odd && d == 0) ? 1 : 2;
             const int shift = odd ? std::max(0, 2 * d - 1) : 2 * d;
             const uint64_t above = base_ >> (shift + width);
-            const uint64_t r = mix_bits(above ^ h);
+            uint64_t r = (above ^ h) * 0xd6e8feb86659fd93ULL;  // one round of a multiply-xorshift hash:
+            r ^= r >> 32;                                     // enough to pick 1 of 24 permutations
+            r *= 0xd6e8feb86659fd93ULL;
             uint64_t digit = (base_ >> shift) & ((uint64_t(1) << width) - 1);
             digit = width == 2 ? kPerm[(r >> 32) % 24][digit] : digit ^ ((r >> 32) & 1u);
             out |= digit << shift;

@@ -106,6 +106,18 @@ inline uint32_t sobol_bits(uint64_t index, int dim) {
     return v;
 }
 
+// Dimensions 0 and 1 together (one pass over the index bits).
+inline void sobol_bits_01(uint64_t index, uint32_t& x, uint32_t& y) {
+    const auto& c0 = sobol_detail::kMatrices[0];
+    const auto& c1 = sobol_detail::kMatrices[1];
+    x = y = 0;
+    for (int k = 0; index != 0; index >>= 1, ++k)
+        if (index & 1u) {
+            x ^= c0[size_t(k)];
+            y ^= c1[size_t(k)];
+        }
+}
+
 inline uint32_t reverse_bits32(uint32_t x) {
     x = (x << 16) | (x >> 16);
     x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
