@@ -1,17 +1,21 @@
 #!/usr/bin/env python3
 """Error of each sampler against a high-spp reference, at equal spp and at equal time.
 
-  python3 bench/samplers/run.py [--candela build/bin/candela] [--spp 64] [--ref-spp 8192]
-                                [--res 64] [--threads 1] [--scenes cornell,veach-mis]
+  $PY bench/samplers/run.py [--candela build/bin/candela] [--spp 64] [--ref-spp 8192] [--res 64]
+                            [--threads 2] [--seeds 3] [--scenes cornell,veach-mis]
 
 For each scene: a reference rendered once by candela's independent sampler (seed 1000, --ref-spp,
-cached in --cache), then per sampler (seed 1):
-  equal spp : --spp samples (sample_count = --spp, so the stratified sets are complete);
-  equal time: a --time-limit of the independent sampler's measured time for --spp, passes of one
-              sample (sample_count still --spp: the stratified samplers' later sets are partial).
-RMSE = sqrt(mean over pixels and channels of (x - ref)^2); 'gain' = RMSE(independent) / RMSE.
-The reference's own noise adds RMSE(independent) * sqrt(spp / ref_spp) in quadrature (printed as
-'ref floor'). Prints a Markdown table (docs/samplers.md has one). Needs numpy only.
+cached in --cache), then per sampler and seed (seeds 1..--seeds):
+  equal spp : --spp samples in one pass, sample_count = --spp (complete stratified sets); the
+              render's wall time (the fastest over the seeds) is the sampler's cost;
+  equal time: the spp the sampler renders in the independent sampler's time,
+              min(spp, floor(spp * t_independent / t_sampler)), with sample_count still --spp: a
+              render stopped early, as --time-limit would stop it (a slower stratified sampler
+              ends inside its last set, which stays unbiased).
+RMSE = sqrt(mean over seeds, pixels and channels of (x - ref)^2 - MSE_ref): the reference's own
+expected MSE, MSE_ref = MSE_independent(spp) * spp / ref_spp (it is that sampler at ref_spp), is
+taken out so that RMSE estimates the error against the true image; 'gain' = RMSE(independent) /
+RMSE. Times are candela's own render times (its summary line), the fastest over the seeds. Prints a Markdown table (docs/samplers.md has one). Needs numpy only.
 """
 import argparse, os, re, subprocess, sys, time
 import numpy as np
@@ -30,21 +34,25 @@ def read_pfm(path):
     return data.reshape(h, w, c).astype(np.float64)
 
 
-def render(args, scene, out, sampler, seed, spp=None, time_limit=None, sample_count=None):
+def render(args, scene, out, sampler, seed, spp, sample_count):
     cmd = [args.candela, *SCENES[scene], "--width", str(args.res), "--height", str(args.res), "--threads",
-           str(args.threads), "--sampler", sampler, "--seed", str(seed), "--out", out]
-    if time_limit is None:
-        cmd += ["--sample-count", str(spp), "--spp-per-frame", str(spp), "--frames", "1"]
-    else:  # passes of 1 spp up to the time limit
-        cmd += ["--sample-count", str(sample_count), "--spp-per-frame", "1", "--frames", str(1 << 20),
-                "--time-limit", f"{time_limit:.3f}"]
-    t0 = time.perf_counter()
+           str(args.threads), "--sampler", sampler, "--seed", str(seed), "--out", out,
+           "--sample-count", str(sample_count), "--spp-per-frame", str(spp), "--frames", "1"]
     r = subprocess.run(cmd, capture_output=True, text=True)
-    dt = time.perf_counter() - t0
-    if r.returncode != 0:
+    m = re.search(r"spp in ([0-9.]+) s", r.stderr)
+    if r.returncode != 0 or not m:
         sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
-    m = re.search(r"(\d+) spp", r.stderr + r.stdout)
-    return dt, (int(m.group(1)) if m else spp)
+    return float(m.group(1))  # the render's own time (candela's summary), without start-up and loading
+
+
+def measure(args, scene, sampler, spp, ref, ref_mse):
+    """RMSE over the seeds with the reference's own expected MSE (ref_mse) taken out, and the time."""
+    mse, times = [], []
+    for seed in range(1, args.seeds + 1):
+        out = f"{args.cache}/{scene}_{sampler}_{seed}.pfm"
+        times.append(render(args, scene, out, sampler, seed, spp, args.spp))
+        mse.append(np.mean((read_pfm(out) - ref) ** 2))
+    return float(np.sqrt(max(np.mean(mse) - ref_mse, 0.0))), min(times)
 
 
 def main():
@@ -53,36 +61,39 @@ def main():
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=8192)
     ap.add_argument("--res", type=int, default=64)
-    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--scenes", default="cornell,veach-mis")
     ap.add_argument("--samplers", default=",".join(SAMPLERS))
     ap.add_argument("--cache", default="/tmp/candela-sampler-bench")
     args = ap.parse_args()
     os.makedirs(args.cache, exist_ok=True)
     samplers = args.samplers.split(",")
-    print(f"{args.res}x{args.res}, {args.spp} spp, {args.threads} thread(s), reference {args.ref_spp} spp independent\n")
-    print("| scene | sampler | RMSE equal spp | gain | time (s) | RMSE equal time | spp reached | gain |")
+    print(f"{args.res}x{args.res}, {args.spp} spp, {args.threads} thread(s), {args.seeds} seeds, "
+          f"reference {args.ref_spp} spp independent\n")
+    print("| scene | sampler | RMSE at equal spp | gain | time (s) | spp at equal time | RMSE at equal time | gain |")
     print("|---|---|---|---|---|---|---|---|")
     for scene in args.scenes.split(","):
         ref_path = f"{args.cache}/{scene}_{args.res}_ref{args.ref_spp}.pfm"
         if not os.path.exists(ref_path):
-            render(args, scene, ref_path, "independent", 1000, spp=args.ref_spp)
+            render(args, scene, ref_path, "independent", 1000, args.ref_spp, args.ref_spp)
         ref = read_pfm(ref_path)
-        base = {}
-        t_ind = None
+        base_spp = base_time = t_ind = None
+        # The reference is the independent sampler at ref_spp: its expected MSE is the independent
+        # sampler's at spp times spp / ref_spp (measured below, with the reference's noise in it).
+        raw, _ = measure(args, scene, "independent", args.spp, ref, 0.0)
+        ref_mse = raw ** 2 * args.spp / (args.ref_spp + args.spp)
         for s in samplers:
-            out = f"{args.cache}/{scene}_{s}.pfm"
-            dt, _ = render(args, scene, out, s, 1, spp=args.spp)
-            e_spp = float(np.sqrt(np.mean((read_pfm(out) - ref) ** 2)))
+            e_spp, t = measure(args, scene, s, args.spp, ref, ref_mse)
             if t_ind is None:
-                t_ind = dt  # the first sampler (independent) sets the time budget
-            dt2, reached = render(args, scene, out, s, 1, time_limit=t_ind, sample_count=args.spp)
-            e_time = float(np.sqrt(np.mean((read_pfm(out) - ref) ** 2)))
-            base.setdefault("spp", e_spp)
-            base.setdefault("time", e_time)
-            print(f"| {scene} | {s} | {e_spp:.5f} | {base['spp'] / e_spp:.2f}x | {dt:.2f} | {e_time:.5f} | {reached} | "
-                  f"{base['time'] / e_time:.2f}x |", flush=True)
-        print(f"| {scene} | (ref floor) | {base['spp'] * np.sqrt(args.spp / args.ref_spp):.5f} | | | | | |")
+                t_ind = t  # the first sampler (independent) sets the time budget
+            n = min(args.spp, int(args.spp * t_ind / t)) if s != samplers[0] else args.spp
+            e_time = e_spp if n == args.spp else measure(args, scene, s, n, ref, ref_mse)[0]
+            base_spp = base_spp or e_spp
+            base_time = base_time or e_time
+            print(f"| {scene} | {s} | {e_spp:.5f} | {base_spp / e_spp:.2f}x | {t:.2f} | {n} | {e_time:.5f} | "
+                  f"{base_time / e_time:.2f}x |", flush=True)
+        print(f"| {scene} | (reference's RMSE, taken out) | {np.sqrt(ref_mse):.5f} | | | | | |")
 
 
 if __name__ == "__main__":
