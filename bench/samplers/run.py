@@ -9,13 +9,16 @@ cached in --cache), then per sampler and seed (seeds 1..--seeds):
   equal spp : --spp samples in one pass, sample_count = --spp (complete stratified sets); the
               render's wall time (the fastest over the seeds) is the sampler's cost;
   equal time: the spp the sampler renders in the independent sampler's time,
-              min(spp, floor(spp * t_independent / t_sampler)), with sample_count still --spp: a
+              min(spp, floor(spp * cost_independent / cost_sampler)), with sample_count still --spp: a
               render stopped early, as --time-limit would stop it (a slower stratified sampler
               ends inside its last set, which stays unbiased).
 RMSE = sqrt(mean over seeds, pixels and channels of (x - ref)^2 - MSE_ref): the reference's own
 expected MSE, MSE_ref = MSE_independent(spp) * spp / ref_spp (it is that sampler at ref_spp), is
 taken out so that RMSE estimates the error against the true image; 'gain' = RMSE(independent) /
-RMSE. Times are candela's own render times (its summary line), the fastest over the seeds. Prints a Markdown table (docs/samplers.md has one). Needs numpy only.
+RMSE. 'cost' is the sampler's cost per sample relative to the independent sampler's: by default
+instructions per sample counted by callgrind (32 x 32, 1 thread, Ir(12 spp) - Ir(4 spp), so that
+start-up cancels), deterministic where wall times on a shared machine vary by +-30%; --cost wall
+uses candela's own render time (its summary line, the fastest over the seeds) instead. Prints a Markdown table (docs/samplers.md has one). Needs numpy only.
 """
 import argparse, os, re, subprocess, sys, time
 import numpy as np
@@ -45,6 +48,23 @@ def render(args, scene, out, sampler, seed, spp, sample_count):
     return float(m.group(1))  # the render's own time (candela's summary), without start-up and loading
 
 
+def instructions(args, scene, sampler, spp):
+    """Instructions (callgrind Ir) of a 32 x 32, 1-thread render of spp samples (start-up included)."""
+    cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", args.candela, *SCENES[scene], "--width",
+           "32", "--height", "32", "--threads", "1", "--sampler", sampler, "--sample-count", str(args.spp),
+           "--spp-per-frame", str(spp), "--frames", "1", "--quiet", "--out", f"{args.cache}/ir.pfm"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    m = re.search(r"refs:\s+([0-9,]+)", r.stderr)
+    if r.returncode != 0 or not m:
+        sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
+    return int(m.group(1).replace(",", ""))
+
+
+def cost(args, scene, sampler):
+    """Instructions per sample: the difference of two renders (12 and 4 spp) removes start-up."""
+    return (instructions(args, scene, sampler, 12) - instructions(args, scene, sampler, 4)) / (8 * 32 * 32)
+
+
 def measure(args, scene, sampler, spp, ref, ref_mse):
     """RMSE over the seeds with the reference's own expected MSE (ref_mse) taken out, and the time."""
     mse, times = [], []
@@ -63,6 +83,8 @@ def main():
     ap.add_argument("--res", type=int, default=64)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--cost", choices=["callgrind", "wall"], default="callgrind",
+                    help="what 'equal time' equalises: instructions per sample (deterministic) or wall time")
     ap.add_argument("--scenes", default="cornell,veach-mis")
     ap.add_argument("--samplers", default=",".join(SAMPLERS))
     ap.add_argument("--cache", default="/tmp/candela-sampler-bench")
@@ -71,8 +93,8 @@ def main():
     samplers = args.samplers.split(",")
     print(f"{args.res}x{args.res}, {args.spp} spp, {args.threads} thread(s), {args.seeds} seeds, "
           f"reference {args.ref_spp} spp independent\n")
-    print("| scene | sampler | RMSE at equal spp | gain | time (s) | spp at equal time | RMSE at equal time | gain |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| scene | sampler | RMSE at equal spp | gain | wall time (s) | cost | spp at equal time | RMSE at equal time | gain |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for scene in args.scenes.split(","):
         ref_path = f"{args.cache}/{scene}_{args.res}_ref{args.ref_spp}.pfm"
         if not os.path.exists(ref_path):
@@ -85,15 +107,16 @@ def main():
         ref_mse = raw ** 2 * args.spp / (args.ref_spp + args.spp)
         for s in samplers:
             e_spp, t = measure(args, scene, s, args.spp, ref, ref_mse)
+            c = cost(args, scene, s) if args.cost == "callgrind" else t
             if t_ind is None:
-                t_ind = t  # the first sampler (independent) sets the time budget
-            n = min(args.spp, int(args.spp * t_ind / t)) if s != samplers[0] else args.spp
+                t_ind = c  # the first sampler (independent) sets the time budget
+            n = min(args.spp, int(args.spp * t_ind / c)) if s != samplers[0] else args.spp
             e_time = e_spp if n == args.spp else measure(args, scene, s, n, ref, ref_mse)[0]
             base_spp = base_spp or e_spp
             base_time = base_time or e_time
-            print(f"| {scene} | {s} | {e_spp:.5f} | {base_spp / e_spp:.2f}x | {t:.2f} | {n} | {e_time:.5f} | "
+            print(f"| {scene} | {s} | {e_spp:.5f} | {base_spp / e_spp:.2f}x | {t:.2f} | {c / t_ind:.3f} | {n} | {e_time:.5f} | "
                   f"{base_time / e_time:.2f}x |", flush=True)
-        print(f"| {scene} | (reference's RMSE, taken out) | {np.sqrt(ref_mse):.5f} | | | | | |")
+        print(f"| {scene} | (reference's RMSE, taken out) | {np.sqrt(ref_mse):.5f} | | | | | | |")
 
 
 if __name__ == "__main__":

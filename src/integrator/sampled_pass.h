@@ -2,7 +2,7 @@
 // The pass of a per-ray integrator with the scene's sampler: a dispatch once per pass to the
 // instantiation of the tile loop for that sampler type (integrator/tiles.h render_pass_for). The
 // independent sampler's is instantiated where this is called (the integrator's translation unit,
-// where it always was); the others are compiled once each in integrator/samplers/<name>.cpp, so
+// where it always was); the others are compiled once each in integrator/samplers/<integrator>_<sampler>.cpp, so
 // their inlining does not change the independent loop's (measured: docs/samplers.md).
 #include "integrator/direct/direct.h"
 #include "integrator/path.h"

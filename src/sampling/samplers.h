@@ -237,7 +237,7 @@ public:
     float next_1d() {
         if (dim_ >= uint32_t(kSobolDimensions)) return rng().next_float();
         const int d = int(dim_);
-        return bits_to_unit(owen_scramble(sobol_bits(index_, d), next_dim_seed(0)));
+        return bits_to_unit(owen_scramble_reversed(sobol_bits_reversed(index_, d), next_dim_seed(0)));
     }
     vec2 next_2d() {
         if (dim_ + 2 > uint32_t(kSobolDimensions)) {
@@ -246,8 +246,8 @@ public:
             return vec2(a, rng().next_float());
         }
         const int d = int(dim_);
-        const float x = bits_to_unit(owen_scramble(sobol_bits(index_, d), next_dim_seed(0)));
-        return vec2(x, bits_to_unit(owen_scramble(sobol_bits(index_, d + 1), next_dim_seed(0))));
+        const float x = bits_to_unit(owen_scramble_reversed(sobol_bits_reversed(index_, d), next_dim_seed(0)));
+        return vec2(x, bits_to_unit(owen_scramble_reversed(sobol_bits_reversed(index_, d + 1), next_dim_seed(0))));
     }
 };
 

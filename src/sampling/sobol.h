@@ -95,11 +95,37 @@ constexpr Matrices make_matrices() {
 
 inline constexpr Matrices kMatrices = make_matrices();
 
+constexpr uint32_t reverse_bits32_constexpr(uint32_t x) {
+    uint32_t r = 0;
+    for (int i = 0; i < 32; ++i) r |= ((x >> i) & 1u) << (31 - i);
+    return r;
+}
+
+// The same columns bit-reversed: the Owen scramble works on reversed values, so the samplers build
+// the reversed point directly and save one reversal per dimension.
+constexpr Matrices make_reversed() {
+    Matrices c = make_matrices();
+    for (auto& d : c)
+        for (auto& v : d) v = reverse_bits32_constexpr(v);
+    return c;
+}
+
+inline constexpr Matrices kReversedMatrices = make_reversed();
+
 }  // namespace sobol_detail
 
 // x_dim(index) as 32 fixed-point bits (unscrambled); dim < kSobolDimensions.
 inline uint32_t sobol_bits(uint64_t index, int dim) {
     const auto& c = sobol_detail::kMatrices[size_t(dim)];
+    uint32_t v = 0;
+    for (int k = 0; index != 0; index >>= 1, ++k)
+        if (index & 1u) v ^= c[size_t(k)];
+    return v;
+}
+
+// reverse_bits32(sobol_bits(index, dim)).
+inline uint32_t sobol_bits_reversed(uint64_t index, int dim) {
+    const auto& c = sobol_detail::kReversedMatrices[size_t(dim)];
     uint32_t v = 0;
     for (int k = 0; index != 0; index >>= 1, ++k)
         if (index & 1u) v ^= c[size_t(k)];
@@ -119,8 +145,7 @@ inline void sobol_bits_01(uint64_t index, uint32_t& x, uint32_t& y) {
 }
 
 inline uint32_t reverse_bits32(uint32_t x) {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = __builtin_bswap32(x);
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
@@ -129,8 +154,8 @@ inline uint32_t reverse_bits32(uint32_t x) {
 
 // Owen scrambling of the 32-bit fixed-point value `v` by the hash of `seed` (Burley 2020, with his
 // constants): on the reversed bits, each step flips bit k by a function of bits 0..k-1 only.
-inline uint32_t owen_scramble(uint32_t v, uint32_t seed) {
-    uint32_t x = reverse_bits32(v);
+// owen_scramble of the value whose bit reversal is `x` (sobol_bits_reversed).
+inline uint32_t owen_scramble_reversed(uint32_t x, uint32_t seed) {
     x += seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
@@ -138,6 +163,7 @@ inline uint32_t owen_scramble(uint32_t v, uint32_t seed) {
     x ^= x * 0x8d22f6e6u;
     return reverse_bits32(x);
 }
+inline uint32_t owen_scramble(uint32_t v, uint32_t seed) { return owen_scramble_reversed(reverse_bits32(v), seed); }
 
 // 32 fixed-point bits to [0, 1): the top 24 bits, exactly representable, so 1 is never returned.
 inline float bits_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
