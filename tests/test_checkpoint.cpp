@@ -66,6 +66,22 @@ TEST(Checkpoint, ResumedRenderEqualsUninterrupted) {
     expect_same_image(d + "/full.exr", d + "/again.exr");
 }
 
+// With a stratified sampler the checkpoint holds the sampler and the sample count its sets are made
+// of: a resume continues the same sets (bit for bit), another sampler or sample count is refused.
+TEST(Checkpoint, ResumeWithAStratifiedSampler) {
+    std::string d = temp_dir("ckpt-sampler");
+    const std::string opts = kScene + " --sampler zsobol --sample-count 8";
+    ASSERT_EQ(run_candela(opts + " --frames 8 --out " + d + "/full.exr").exit_code, 0);
+    ASSERT_EQ(run_candela(opts + " --frames 3 --out " + d + "/part.exr --checkpoint " + d + "/part.ck").exit_code, 0);
+    RunResult b = run_candela(opts + " --frames 8 --threads 1 --out " + d + "/part.exr --resume " + d + "/part.ck");
+    ASSERT_EQ(b.exit_code, 0) << b.output;
+    expect_same_image(d + "/full.exr", d + "/part.exr");
+    const std::string resume = " --frames 8 --out " + d + "/c.exr --resume " + d + "/part.ck";
+    expect_clean_error(run_candela(kScene + " --sampler zsobol --sample-count 16" + resume), "another scene or other settings");
+    expect_clean_error(run_candela(kScene + " --sampler ldsampler --sample-count 8" + resume), "another scene or other settings");
+    expect_clean_error(run_candela(kScene + resume), "another scene or other settings");
+}
+
 TEST(Checkpoint, ResumeAfterSigkillEqualsUninterrupted) {
     std::string d = temp_dir("ckpt-kill");
     // A render that would run for ages, saving after every pass; killed once it has saved two.
@@ -98,6 +114,7 @@ TEST(Checkpoint, RefusesAnotherSceneOrSettings) {
     expect_clean_error(run_candela(kScene + " --max-depth 3" + resume), "another scene or other settings");
     expect_clean_error(run_candela(kScene + " --sampling bsdf" + resume), "another scene or other settings");
     expect_clean_error(run_candela(kScene + " --accel brute" + resume), "another scene or other settings");
+    expect_clean_error(run_candela(kScene + " --sampler sobol" + resume), "another scene or other settings");
     expect_clean_error(run_candela("--width 20 --height 24 --quiet" + resume), "checkpoint is of a 24x20 image");
     write_text(d + "/rect.xml",
                "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><film type=\"hdrfilm\">"

@@ -77,6 +77,13 @@ TEST(Cli, BadSamplingMode) {
     expect_clean_error(run_candela("--sampling fancy --out " + d + "/x.exr"), "fancy");
 }
 
+TEST(Cli, BadSampler) {
+    std::string d = temp_dir("sampler");
+    expect_clean_error(run_candela("--sampler fancy --out " + d + "/x.exr"), "unknown sampler 'fancy'");
+    expect_clean_error(run_candela("--sampler orthogonal --out " + d + "/x.exr"), "sampler 'orthogonal' is not supported");
+    EXPECT_NE(run_candela("--sample-count 0 --out " + d + "/x.exr").exit_code, 0);
+}
+
 TEST(Cli, HeadlessRenderWritesEveryFormat) {
     std::string d = temp_dir("formats");
     for (const char* ext : {"exr", "pfm", "png"}) {

@@ -201,6 +201,33 @@ TEST(SceneXml, SensorFilmSamplerIntegratorValues) {
     EXPECT_EQ(s.settings.height, 16);
     EXPECT_EQ(s.settings.spp, 17);
     EXPECT_EQ(s.settings.seed, 5u);
+    EXPECT_EQ(s.settings.sampler, SamplerDesc());
+}
+
+// The sampler plugins: the type, jitter, and the sample count rounded up to what the sampler
+// stratifies over, with a warning naming the file and line (Mitsuba rounds the same way).
+TEST(SceneXml, SamplerPlugins) {
+    auto load = [](const std::string& sampler) {
+        return load_mitsuba_xml(write_temp("smp.xml", scene_xml("<sensor type=\"perspective\">\n" + sampler + "</sensor>\n")), {});
+    };
+    SceneDescription a = load("<sampler type=\"stratified\"><integer name=\"sample_count\" value=\"10\"/>"
+                              "<boolean name=\"jitter\" value=\"false\"/><integer name=\"seed\" value=\"3\"/></sampler>");
+    EXPECT_EQ(a.settings.sampler.type, SamplerType::Stratified);
+    EXPECT_FALSE(a.settings.sampler.jitter);
+    EXPECT_EQ(a.settings.spp, 16);
+    EXPECT_EQ(a.settings.seed, 3u);
+    ASSERT_EQ(a.warnings.size(), 1u);
+    EXPECT_NE(a.warnings[0].find("smp.xml:"), std::string::npos) << a.warnings[0];
+    EXPECT_NE(a.warnings[0].find("rounded up to 16"), std::string::npos) << a.warnings[0];
+    const std::pair<const char*, int> cases[] = {{"multijitter", 12}, {"ldsampler", 16}, {"sobol", 10}, {"zsobol", 16}};
+    for (const auto& [name, spp] : cases) {
+        SceneDescription b = load(std::string("<sampler type=\"") + name + "\"><integer name=\"sample_count\" value=\"10\"/></sampler>");
+        SamplerType t;
+        ASSERT_TRUE(parse_sampler_type(name, t));
+        EXPECT_EQ(b.settings.sampler.type, t) << name;
+        EXPECT_TRUE(b.settings.sampler.jitter) << name;
+        EXPECT_EQ(b.settings.spp, spp) << name;
+    }
 }
 
 TEST(SceneXml, SubstitutionInEveryAttribute) {
@@ -407,7 +434,11 @@ TEST(SceneXml, Errors) {
                  "</emitter></shape>\n", 4, "unused parameter 'scale' in emitter 'area'");
     expect_error("<sensor type=\"perspective\"/>\n<sensor type=\"perspective\"/>\n", 3, "more than one <sensor>");
     expect_error("<shape type=\"rectangle\" color=\"red\"/>\n", 2, "unexpected attribute 'color'");
-    expect_error("<sensor type=\"perspective\">\n<sampler type=\"stratified\"/></sensor>\n", 3, "unsupported sampler type");
+    expect_error("<sensor type=\"perspective\">\n<sampler type=\"halton\"/></sensor>\n", 3, "unsupported sampler type");
+    expect_error("<sensor type=\"perspective\">\n<sampler type=\"orthogonal\"/></sensor>\n", 3,
+                 "sampler 'orthogonal' is not supported");
+    expect_error("<sensor type=\"perspective\">\n<sampler type=\"sobol\"><boolean name=\"jitter\" value=\"false\"/>"
+                 "</sampler></sensor>\n", 3, "unused parameter 'jitter'");
     expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\"><integer name=\"width\" value=\"0\"/></film></sensor>\n", 3,
                  "width must be positive");
     expect_error("<sensor type=\"perspective\">\n<string name=\"fov_axis\" value=\"z\"/><float name=\"fov\" value=\"9\"/></sensor>\n", 3,

@@ -191,6 +191,14 @@ uint64_t scene_fingerprint(const Scene& scene) {
         h.i64(in.emitter_samples);
         h.i64(in.bsdf_samples);
     }
+    // The sampler, and the sample count its stratified sets are made of (the independent sampler
+    // adds nothing, so that checkpoints made before the other samplers stay valid).
+    if (st.sampler != SamplerDesc()) {
+        h.str("sampler");
+        h.i64(int(st.sampler.type));
+        h.u64(st.sampler.jitter);
+        h.i64(st.spp);
+    }
     if (st.filter != FilterDesc()) {
         h.str("filter");
         h.i64(int(st.filter.type));

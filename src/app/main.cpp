@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> defines;
     int width = 0, height = 0, max_depth = -2, rr_depth = -2;
     uint64_t seed = 0;
-    std::string sampling;
+    std::string sampling, sampler_name;
+    int sample_count = 0;
     app.add_option("scene", opt.scene, "Scene file: Mitsuba 3 XML subset (.xml) or OBJ+MTL (.obj)");
     app.add_option("--frames", opt.frames, "Passes to render (default: the scene's sample_count / spp-per-frame)")
         ->check(CLI::Range(1, 1 << 30));
@@ -43,6 +44,13 @@ int main(int argc, char** argv) {
     app.add_option("--exposure", opt.display.exposure, "Exposure in stops for PNG output and the viewer");
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
+    auto* sampler_opt = app.add_option("--sampler", sampler_name,
+                                       "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"
+                                       "sobol (Owen-scrambled per pixel) or zsobol (Z-order blue noise); docs/samplers.md");
+    auto* count_opt = app.add_option("--sample-count", sample_count,
+                                     "The scene's sample_count (overrides it): the default total spp, and what the\n"
+                                     "stratified samplers stratify over (rounded up as the sampler needs)")
+                          ->check(CLI::Range(1, 1 << 24));
     app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
     app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
     auto* ck_opt = app.add_option("--checkpoint", opt.checkpoint,
@@ -90,6 +98,8 @@ int main(int argc, char** argv) {
         if (*r_opt) ov.rr_depth = rr_depth;
         if (*s_opt) ov.seed = seed;
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
+        if (*sampler_opt) ov.sampler = parse_sampler_name(sampler_name);
+        if (*count_opt) ov.sample_count = sample_count;
 
 #ifdef CANDELA_HAS_MPI
         // Under mpirun or srun every rank renders a share of one headless render.

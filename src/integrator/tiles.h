@@ -3,7 +3,10 @@
 // dynamically, each pixel sample seeded from (pixel, sample index, seed), its camera ray jittered
 // uniformly in the pixel, its radiance estimated by `li` and added to the film.
 //
-//   li(IndependentSampler& sampler, Ray camera_ray, PathStats& stats) -> vec3 radiance
+//   li(S& sampler, Ray camera_ray, PathStats& stats) -> vec3 radiance
+//
+// S is the pass's sampler type (sampling/samplers.h), chosen once per pass (render_pass_for):
+// each tile copies the prototype and seeds it per pixel sample.
 //
 // Box filter (the film unweighted): each sample goes to its own pixel, which only its tile
 // writes, in sample order: the plain loop of before, at its speed.
@@ -25,6 +28,7 @@
 #include "integrator/integrator.h"
 #include "integrator/path.h"
 #include "sampling/sampler.h"
+#include "sampling/samplers.h"
 
 namespace candela {
 
@@ -73,9 +77,22 @@ inline TileRange tile_range(int tile, int tiles_x, int w, int h) {
 
 }  // namespace detail
 
-template <class Li>
+// The sampler of a pass over `film`: the scene's, its seed and sample_count, and the range of the
+// sampler pixels (the film's pixels shifted by a crop window's offset).
+inline SamplerSetup sampler_setup(const Scene& scene, const Film& film) {
+    Camera camera = scene.camera;
+    camera.set_film_size(film.width(), film.height());
+    SamplerSetup s;
+    s.desc = scene.settings.sampler;
+    s.seed = scene.settings.seed;
+    s.sample_count = uint32_t(std::max(1, scene.settings.spp));
+    s.resolution = camera.sampler_pixel(ivec2(film.width() - 1, film.height() - 1)) + 1;
+    return s;
+}
+
+template <class S, class Li>
 PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
-                       const std::atomic<bool>* cancel, const Li& li) {
+                       const std::atomic<bool>* cancel, const S& prototype, const Li& li) {
     const int w = film.width(), h = film.height();
     const int tiles_x = (w + kTileSize - 1) / kTileSize;
     const int tiles_y = (h + kTileSize - 1) / kTileSize;
@@ -103,7 +120,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
         for (int tile = 0; tile < n_tiles; ++tile) {
             if (cancelled()) continue;
-            IndependentSampler sampler(scene.settings.seed);
+            S sampler = prototype;
             PathStats ps;
             uint64_t samples = 0;
             float aov[64];
@@ -142,7 +159,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
             for (int tile = 0; tile < n_tiles; ++tile) {
                 if (cancelled()) continue;
-                IndependentSampler sampler(scene.settings.seed);
+                S sampler = prototype;
                 PathStats ps;
                 uint64_t samples = 0;
                 float aov[64];
@@ -189,20 +206,23 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
     return out;
 }
 
-// A pass of a per-ray integrator (`Integrator(scene).Li<Sampler, DiffuseOnly>(ray, sampler, stats)`)
-// over all tiles, instantiated for the scene's materials: DiffuseOnly when every material is
-// diffuse. Chosen per pass, so that a material edited in the viewer (which restarts the
-// accumulation) switches the instantiation too; both give the same image, the specialisation only
-// drops code.
-template <class Integrator>
-PassStats render_integrator_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
-                                 const std::atomic<bool>* cancel) {
+// A pass of a per-ray integrator (`Integrator(scene).Li<S, DiffuseOnly>(ray, sampler, stats)`)
+// over all tiles with the sampler type S, instantiated for the scene's materials: DiffuseOnly when
+// every material is diffuse. Chosen per pass, so that a material edited in the viewer (which
+// restarts the accumulation) switches the instantiation too; both give the same image, the
+// specialisation only drops code. The sampler type is chosen per pass too
+// (integrator/sampled_pass.h): the independent sampler's instantiation lives in the integrator's
+// own translation unit, as it always did, the others each in their own (integrator/samplers/), so
+// that no instantiation changes how the compiler inlines another.
+template <class Integrator, class S>
+PassStats render_pass_for(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
+                          const std::atomic<bool>* cancel) {
+    const S prototype = make_sampler<S>(sampler_setup(scene, film));
     auto run = [&](auto diffuse_only) {
         const Integrator integrator(scene);
-        return render_tiles(scene, film, first_sample, spp, n_threads, cancel,
-                            [&](IndependentSampler& sampler, Ray ray, PathStats& ps) {
-                                return integrator.template Li<IndependentSampler, decltype(diffuse_only)::value>(
-                                    ray, sampler, ps);
+        return render_tiles(scene, film, first_sample, spp, n_threads, cancel, prototype,
+                            [&](S& sampler, Ray ray, PathStats& ps) {
+                                return integrator.template Li<S, decltype(diffuse_only)::value>(ray, sampler, ps);
                             });
     };
     return scene_is_diffuse_only(scene) ? run(std::true_type{}) : run(std::false_type{});

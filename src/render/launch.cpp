@@ -13,6 +13,13 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
     if (ov.rr_depth) st.rr_depth = *ov.rr_depth;
     if (ov.seed) st.seed = *ov.seed;
     if (ov.sampling) st.sampling = *ov.sampling;
+    if (ov.sampler) st.sampler.type = *ov.sampler;
+    if (ov.sample_count) {
+        if (*ov.sample_count < 1) throw Error("--sample-count must be >= 1");
+        st.spp = *ov.sample_count;
+    }
+    // What the sampler stratifies over (a square, a power of two, ...), as the XML reader rounds it.
+    if (ov.sampler || ov.sample_count) st.spp = int(sampler_sample_count(st.sampler.type, uint32_t(st.spp)));
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
 }
@@ -30,6 +37,13 @@ SamplingMode parse_sampling_mode(const std::string& s) {
     if (s == "bsdf") return SamplingMode::Bsdf;
     if (s == "mis") return SamplingMode::Mis;
     throw Error("unknown sampling mode '" + s + "' (expected light, bsdf or mis)");
+}
+
+SamplerType parse_sampler_name(const std::string& s) {
+    SamplerType t;
+    if (parse_sampler_type(s, t)) return t;
+    if (s == "orthogonal") throw Error("sampler 'orthogonal' is not supported by candela (use multijitter, ldsampler or sobol)");
+    throw Error("unknown sampler '" + s + "' (expected independent, stratified, multijitter, ldsampler, sobol or zsobol)");
 }
 
 const char* sampling_mode_name(SamplingMode m) {

@@ -14,6 +14,8 @@ struct SceneOverrides {
     std::optional<int> width, height, max_depth, rr_depth;
     std::optional<uint64_t> seed;
     std::optional<SamplingMode> sampling;
+    std::optional<SamplerType> sampler;  // --sampler (jitter keeps the scene's)
+    std::optional<int> sample_count;     // --sample-count: the scene's sample_count
     std::string accel = "auto";
 };
 
@@ -23,5 +25,7 @@ std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneO
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
 const char* sampling_mode_name(SamplingMode m);
+// --sampler NAME: a sampler_type_name; "orthogonal" and unknown names are errors.
+SamplerType parse_sampler_name(const std::string& s);
 
 }  // namespace candela

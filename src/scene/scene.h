@@ -21,6 +21,7 @@
 #include "geometry/mesh.h"
 #include "integrator/desc.h"
 #include "light/area.h"
+#include "sampling/sampler_desc.h"
 #include "scene/camera.h"
 
 namespace candela {
@@ -31,8 +32,10 @@ enum class SamplingMode { Light, Bsdf, Mis };
 struct RenderSettings {
     int width = 512, height = 512;  // the rendered image: the film, or its crop window (Camera)
     bool alpha = false;      // hdrfilm pixel_format rgba: the image gets an alpha channel
-    int spp = 64;            // sampler sample_count: the default number of passes x spp per pass
+    int spp = 64;            // sampler sample_count: the default number of passes x spp per pass,
+                             // and what the stratified samplers stratify over (docs/samplers.md)
     uint64_t seed = 0;
+    SamplerDesc sampler;     // which sampler draws the random numbers (sampling/samplers.h)
     int max_depth = -1;      // scattering events; -1 = unbounded (Russian roulette ends paths)
     int rr_depth = 5;        // scattering events before Russian roulette starts
     SamplingMode sampling = SamplingMode::Mis;

@@ -92,6 +92,15 @@ void Viewer::panel() {
             st.sampling = SamplingMode(mode);
             fe_->params_changed(viewer_now());
         }
+        int sampler = int(st.sampler.type);
+        if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0")) {
+            st.sampler.type = SamplerType(sampler);
+            fe_->params_changed(viewer_now());
+        }
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Where the random numbers come from (docs/samplers.md). The stratified ones stratify\n"
+                              "over the scene's sample_count (%d): complete sets every %u samples.",
+                              st.spp, sampler_sample_count(st.sampler.type, uint32_t(std::max(1, st.spp))));
         if (ImGui::InputInt("max depth", &st.max_depth)) {
             st.max_depth = std::max(-1, st.max_depth);
             fe_->params_changed(viewer_now());

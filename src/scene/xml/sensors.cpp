@@ -24,13 +24,35 @@ void make_hdrfilm(XmlLoader& L, Object& o, RenderSettings& s) {
     s.alpha = f.alpha;
 }
 
-void make_independent(XmlLoader&, Object& o, RenderSettings& s) {
+// The sampler plugins: sample_count and seed for all (Mitsuba's defaults 4 and 0), jitter for the
+// stratified ones; sobol and zsobol are candela's own (docs/samplers.md). The sample count is
+// rounded up to what the sampler stratifies over, as Mitsuba does (a warning says so).
+void read_sampler(XmlLoader& L, Object& o, RenderSettings& s, SamplerType type) {
     int spp = o.params.get_int("sample_count", 4);
     int seed = o.params.get_int("seed", 0);
     if (spp <= 0) throw o.params.error("sample_count", "sample_count must be positive");
     if (seed < 0) throw o.params.error("seed", "seed must not be negative");
-    s.spp = spp;
+    s.sampler = SamplerDesc();
+    s.sampler.type = type;
+    if (type == SamplerType::Stratified || type == SamplerType::Multijitter)
+        s.sampler.jitter = o.params.get_bool("jitter", true);
+    const uint32_t rounded = sampler_sample_count(type, uint32_t(spp));
+    if (rounded != uint32_t(spp))
+        L.scene().warnings.push_back(L.file_of(o.node) + ":" + std::to_string(o.line) + ": " + o.type + " sampler: sample_count " +
+                                     std::to_string(spp) + " rounded up to " + std::to_string(rounded));
+    s.spp = int(rounded);
     s.seed = uint64_t(seed);
+}
+
+void make_independent(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Independent); }
+void make_stratified(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Stratified); }
+void make_multijitter(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Multijitter); }
+void make_ldsampler(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::LdSampler); }
+void make_sobol(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Sobol); }
+void make_zsobol(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::ZSobol); }
+// Mitsuba's orthogonal-array sampler (Jarosz et al. 2019) is not implemented: refused by name.
+void make_orthogonal(XmlLoader& L, Object& o, RenderSettings&) {
+    throw L.error(o.node, "sampler 'orthogonal' is not supported by candela (use multijitter, ldsampler or sobol)");
 }
 
 }  // namespace
@@ -53,7 +75,9 @@ const PluginTable<FilmFactory>& film_plugins() {
 
 const PluginTable<SamplerFactory>& sampler_plugins() {
     static const PluginTable<SamplerFactory> table = {
-        {"independent", make_independent},
+        {"independent", make_independent}, {"stratified", make_stratified}, {"multijitter", make_multijitter},
+        {"ldsampler", make_ldsampler},     {"sobol", make_sobol},           {"zsobol", make_zsobol},
+        {"orthogonal", make_orthogonal},
     };
     return table;
 }
