@@ -37,6 +37,12 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_option("--exposure", opt.display.exposure, "Exposure in stops for PNG output and the viewer");
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
+    std::string integrator;
+    auto* i_opt = app.add_option("--integrator", integrator,
+                                 "Integrator: path (the path tracer), direct (direct lighting) or ptracer (light\n"
+                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer); replaces the\n"
+                                 "scene's <integrator> type, keeping its depths and hide_emitters")
+                      ->check(CLI::IsMember({"path", "direct", "ptracer"}));
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
     app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
@@ -85,6 +91,7 @@ int main(int argc, char** argv) {
         if (*r_opt) ov.rr_depth = rr_depth;
         if (*s_opt) ov.seed = seed;
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
+        if (*i_opt) ov.integrator = parse_integrator_type(integrator);
 
         bool has_display = std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY");
         std::string why_headless = has_display ? "built without the viewer" : "no display";

@@ -1,6 +1,5 @@
 #include "film/film.h"
 #include <algorithm>
-#include <mutex>
 
 namespace candela {
 
@@ -14,6 +13,7 @@ void Film::resize(int width, int height) {
     else weight_.clear();
     aov_.assign(n * size_t(aov_channels_), 0.0);
     splat_.clear();
+    splat_paths_ = 0;
     if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
     nonfinite_ = 0;
 }
@@ -77,19 +77,27 @@ void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int m
     else alpha.clear();
 }
 
-void Film::add_splat(vec2 film_pos, vec3 L) {
-    int x = int(film_pos.x), y = int(film_pos.y);
-    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+void Film::add_splat(vec2 pos, vec3 L) {
+    if (!(pos.x >= 0.f && pos.y >= 0.f && pos.x < float(width_) && pos.y < float(height_))) return;
     if (!all_finite(L)) {
         nonfinite_.fetch_add(1, std::memory_order_relaxed);
         return;
     }
-    // Splats arrive from any thread to any pixel; they are rare enough for a lock here, and
-    // bidirectional integrators buffer them per thread before calling this.
-    static std::mutex m;
-    std::lock_guard<std::mutex> lock(m);
     if (splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
+    const int x = std::min(int(pos.x), width_ - 1), y = std::min(int(pos.y), height_ - 1);
     splat_[size_t(y) * size_t(width_) + size_t(x)] += dvec3(L);
+}
+
+void Film::add_splats(const SplatTile& t) {
+    if (!t.pixel.empty() && splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
+    for (size_t k = 0; k < t.pixel.size(); ++k) splat_[t.pixel[k]] += dvec3(t.value[k]);
+    splat_paths_ += t.paths;
+    if (t.nonfinite) nonfinite_.fetch_add(t.nonfinite, std::memory_order_relaxed);
+}
+
+void Film::restore_splats(std::vector<dvec3> sums, uint64_t paths) {
+    splat_ = std::move(sums);
+    splat_paths_ = paths;
 }
 
 vec3 Film::pixel(int x, int y) const {
@@ -97,7 +105,7 @@ vec3 Film::pixel(int x, int y) const {
     dvec3 v;
     if (weighted_) v = weight_[i] > 0.0 ? sum_[i] / weight_[i] : dvec3(0.0);
     else v = count_[i] > 0 ? sum_[i] / double(count_[i]) : dvec3(0.0);
-    if (!splat_.empty()) v += splat_[i] * splat_scale_;
+    v += splat_value(i);
     return vec3(v);
 }
 
@@ -145,6 +153,8 @@ void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64
     count_ = std::move(counts);
     weight_ = std::move(weights);
     nonfinite_ = nonfinite;
+    splat_.clear();
+    splat_paths_ = 0;
 }
 
 }  // namespace candela

@@ -14,6 +14,7 @@ struct SceneOverrides {
     std::optional<int> width, height, max_depth, rr_depth;
     std::optional<uint64_t> seed;
     std::optional<SamplingMode> sampling;
+    std::optional<IntegratorType> integrator;  // --integrator: replaces the scene's <integrator>
     std::string accel = "auto";
 };
 
@@ -22,6 +23,8 @@ struct SceneOverrides {
 std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
+IntegratorType parse_integrator_type(const std::string& s);  // path | direct | ptracer
+const char* integrator_type_name(IntegratorType t);
 const char* sampling_mode_name(SamplingMode m);
 
 }  // namespace candela
