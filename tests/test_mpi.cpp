@@ -90,7 +90,12 @@ TEST(Mpi, OneTwoThreeRanksGiveThePlainImageBitForBit) {
                               "/scenes/cbox_filter.xml -D res=20 -D filter=gaussian --threads 1 --seed 3 --quiet "
                               "--frames 5 --spp-per-frame 2";
     const std::string aov = cbox_with_aovs_and_alpha(d) + " -D res=16 -D filter=gaussian --threads 1 --seed 3 --quiet --frames 4";
-    for (auto [name, args] : {std::pair<std::string, std::string>{"box", box}, {"gauss", gauss}, {"aov", aov}}) {
+    // The light tracer's splats (and their light-path count) travel in the layers too; the sobol
+    // sampler's numbers depend on the sample index only, not on the rank that draws them.
+    const std::string ptracer = kBox + " --frames 4 --integrator ptracer";
+    const std::string sobol = kBox + " --frames 6 --sampler sobol";
+    for (auto [name, args] : {std::pair<std::string, std::string>{"box", box}, {"gauss", gauss}, {"aov", aov},
+                              {"ptracer", ptracer}, {"sobol", sobol}}) {
         const std::string plain = d + "/" + name + "-plain";
         const bool ck = name != "aov";  // checkpoints do not hold AOV layers
         RunResult p = run_candela(args + " --out " + plain + ".exr" + (ck ? " --checkpoint " + plain + ".ck" : ""));

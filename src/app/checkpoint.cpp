@@ -78,8 +78,9 @@ static_assert(sizeof(vec3) == 12 && sizeof(uvec3) == 12 && sizeof(dvec3) == 24, 
 //   16 i32 width                      20 i32 height           24 u32 spp        28 u32 flags (1: alpha, 2: weighted)
 //   32 u64 non-finite samples         40 u64 fingerprint      48 u64 pixels     56 u64 byte-order marker
 //   64 pixels x 3 f64 sums, then pixels x u32 counts, then (flag alpha) pixels x f64 alpha sums, then
-//   (flag weighted: tent, gaussian filters) pixels x f64 weight sums, then u64 hash of everything
-//   before it. Box-filtered files without alpha are those of before.
+//   (flag weighted: tent, gaussian filters) pixels x f64 weight sums, then (flag 4, splats: light
+//   tracing) u64 light paths and pixels x 3 f64 splat sums, then u64 hash of everything before it.
+//   Files without splats are those of before (and still load).
 constexpr char kMagic[8] = {'C', 'N', 'D', 'L', 'C', 'K', 'P', 'T'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderSize = 64;
@@ -369,7 +370,8 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     put<int32_t>(header, 16, film.width());
     put<int32_t>(header, 20, film.height());
     put<uint32_t>(header, 24, spp);
-    put<uint32_t>(header, 28, (film.has_alpha() ? 1u : 0u) | (film.weighted() ? 2u : 0u));
+    const bool splats = film.has_splats();
+    put<uint32_t>(header, 28, (film.has_alpha() ? 1u : 0u) | (film.weighted() ? 2u : 0u) | (splats ? 4u : 0u));
     put<uint64_t>(header, 32, film.nonfinite_count());
     put<uint64_t>(header, 40, fingerprint);
     put<uint64_t>(header, 48, uint64_t(sums.size()));
@@ -381,6 +383,17 @@ void save_checkpoint(const std::string& path, const Film& film, uint32_t spp, ui
     w.write(counts.data(), counts.size() * sizeof(uint32_t));
     if (film.has_alpha()) w.write(film.alpha_sums().data(), film.alpha_sums().size() * sizeof(double));
     if (film.weighted()) w.write(film.weights().data(), film.weights().size() * sizeof(double));
+    if (splats) {
+        const uint64_t paths = film.splat_paths();
+        w.write(&paths, sizeof paths);
+        std::vector<dvec3> zero;
+        const std::vector<dvec3>* ss = &film.splat_sums();
+        if (ss->empty()) {  // light paths traced, none landed: store zeros (one layout for all)
+            zero.assign(sums.size(), dvec3(0.0));
+            ss = &zero;
+        }
+        w.write(ss->data(), ss->size() * sizeof(dvec3));
+    }
     uint64_t check = w.hash();
     w.write(&check, sizeof check);
     w.commit();
@@ -416,13 +429,15 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         pixels != uint64_t(info.width) * uint64_t(info.height))
         throw Error(path, 0, "corrupt checkpoint (bad image size)");
     const uint32_t flags = get<uint32_t>(header, 28);
-    if (flags > 3) throw Error(path, 0, "corrupt checkpoint (unknown flags)");
-    const bool alpha = (flags & 1u) != 0, weighted = (flags & 2u) != 0;
+    if (flags > 7) throw Error(path, 0, "corrupt checkpoint (unknown flags)");
+    const bool alpha = (flags & 1u) != 0, weighted = (flags & 2u) != 0, splats = (flags & 4u) != 0;
     if (alpha != film.has_alpha())
         throw Error(path, 0, std::string("checkpoint ") + (alpha ? "has" : "has no") + " alpha channel, this render " +
                                  (film.has_alpha() ? "has one" : "has none") + "; refusing to resume");
     const uint64_t expected =
-        kHeaderSize + pixels * (kBytesPerPixel + (alpha ? sizeof(double) : 0) + (weighted ? sizeof(double) : 0)) + 8;
+        kHeaderSize + pixels * (kBytesPerPixel + (alpha ? sizeof(double) : 0) + (weighted ? sizeof(double) : 0) +
+                                (splats ? sizeof(dvec3) : 0)) +
+        (splats ? 8 : 0) + 8;
     if (file_size != expected)
         throw Error(path, 0, "truncated or corrupt checkpoint (" + std::to_string(file_size) + " bytes, expected " +
                                  std::to_string(expected) + ")");
@@ -445,6 +460,12 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
     std::vector<double> alpha_sums(alpha ? static_cast<size_t>(pixels) : 0);
     if (alpha) read_exact(f.get(), alpha_sums.data(), alpha_sums.size() * sizeof(double), path);
     read_exact(f.get(), weights.data(), weights.size() * sizeof(double), path);
+    uint64_t splat_paths = 0;
+    std::vector<dvec3> splat_sums(splats ? static_cast<size_t>(pixels) : 0);
+    if (splats) {
+        read_exact(f.get(), &splat_paths, sizeof splat_paths, path);
+        read_exact(f.get(), splat_sums.data(), splat_sums.size() * sizeof(dvec3), path);
+    }
     uint64_t stored = 0;
     read_exact(f.get(), &stored, sizeof stored, path);
     Hasher h;
@@ -453,6 +474,10 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
     h.bytes(counts.data(), counts.size() * sizeof(uint32_t));
     if (alpha) h.bytes(alpha_sums.data(), alpha_sums.size() * sizeof(double));
     h.bytes(weights.data(), weights.size() * sizeof(double));
+    if (splats) {
+        h.bytes(&splat_paths, sizeof splat_paths);
+        h.bytes(splat_sums.data(), splat_sums.size() * sizeof(dvec3));
+    }
     if (h.digest() != stored) throw Error(path, 0, "corrupt checkpoint (checksum mismatch)");
     // Whole passes only, and sums the film could have made (non-finite samples never enter them).
     for (uint32_t c : counts)
@@ -468,7 +493,13 @@ CheckpointInfo load_checkpoint(const std::string& path, Film& film, uint64_t fin
         const double limit = weighted ? weights[i] * (1.0 + 1e-9) : double(info.spp);
         if (!(alpha_sums[i] >= 0.0 && alpha_sums[i] <= limit)) throw Error(path, 0, "corrupt checkpoint (alpha out of range)");
     }
+    for (const dvec3& s : splat_sums)
+        if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z))
+            throw Error(path, 0, "corrupt checkpoint (non-finite splat sum)");
+    if (splats && splat_paths != pixels * uint64_t(info.spp))
+        throw Error(path, 0, "corrupt checkpoint (light paths do not match the samples)");
     film.restore(std::move(sums), std::move(counts), info.nonfinite, std::move(weights));
+    if (splats) film.restore_splats(std::move(splat_sums), splat_paths);
     if (alpha) film.restore_alpha(std::move(alpha_sums));
     return info;
 }

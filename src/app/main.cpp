@@ -43,6 +43,12 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_option("--exposure", opt.display.exposure, "Exposure in stops for PNG output and the viewer");
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
+    std::string integrator;
+    auto* i_opt = app.add_option("--integrator", integrator,
+                                 "Integrator: path (the path tracer), direct (direct lighting) or ptracer (light\n"
+                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer); replaces the\n"
+                                 "scene's <integrator> type, keeping its depths and hide_emitters")
+                      ->check(CLI::IsMember({"path", "direct", "ptracer"}));
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
                                        "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"
@@ -100,6 +106,7 @@ int main(int argc, char** argv) {
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
         if (*sampler_opt) ov.sampler = parse_sampler_name(sampler_name);
         if (*count_opt) ov.sample_count = sample_count;
+        if (*i_opt) ov.integrator = parse_integrator_type(integrator);
 
 #ifdef CANDELA_HAS_MPI
         // Under mpirun or srun every rank renders a share of one headless render.

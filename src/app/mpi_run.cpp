@@ -64,6 +64,7 @@ struct LayerHeader {
     uint32_t complete = 0;  // 1: every tile; 0: cut by a stop
     uint64_t samples = 0, rays = 0, nonfinite = 0;
     uint32_t has_splats = 0, pad = 0;
+    uint64_t splat_paths = 0;  // light paths traced for the layer's splats (light tracing)
 };
 
 template <class T>
@@ -82,14 +83,15 @@ std::vector<char> pack_layer(const Film& f, uint32_t index, const PassStats& ps)
     h.samples = ps.samples;
     h.rays = ps.rays;
     h.nonfinite = f.nonfinite_count();
-    h.has_splats = f.splats().empty() ? 0 : 1;
+    h.has_splats = f.splat_sums().empty() ? 0 : 1;
+    h.splat_paths = f.splat_paths();
     std::vector<char> b(sizeof h);
     std::memcpy(b.data(), &h, sizeof h);
     put(b, f.sums());  // the doubles first, so that they are aligned when read in place
     if (f.weighted()) put(b, f.weights());
     put(b, f.aov_sums());
     if (f.has_alpha()) put(b, f.alpha_sums());
-    if (h.has_splats) put(b, f.splats());
+    if (h.has_splats) put(b, f.splat_sums());
     put(b, f.counts());
     if (b.size() > size_t(INT_MAX)) throw Error("the image is too large for one MPI message (2 GB): render it in crops");
     return b;
@@ -151,7 +153,7 @@ struct Layer {
             return;
         }
         const LayerView v = view_layer(bytes, total);
-        total.add(v.sums, v.counts, v.weights, v.aov, v.alpha, v.splats, v.h.nonfinite);
+        total.add(v.sums, v.counts, v.weights, v.aov, v.alpha, v.splats, v.h.splat_paths, v.h.nonfinite);
     }
 };
 

@@ -1,6 +1,5 @@
 #include "film/film.h"
 #include <algorithm>
-#include <mutex>
 
 namespace candela {
 
@@ -14,6 +13,7 @@ void Film::resize(int width, int height) {
     else weight_.clear();
     aov_.assign(n * size_t(aov_channels_), 0.0);
     splat_.clear();
+    splat_paths_ = 0;
     if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
     nonfinite_ = 0;
 }
@@ -65,11 +65,11 @@ void Film::merge(const FilmTile& t) {
 
 void Film::add(const Film& o) {
     add(o.sum_.data(), o.count_.data(), o.weight_.data(), o.aov_.data(), o.alpha_enabled_ ? o.alpha_.data() : nullptr,
-        o.splat_.empty() ? nullptr : o.splat_.data(), o.nonfinite_count());
+        o.splat_.empty() ? nullptr : o.splat_.data(), o.splat_paths_, o.nonfinite_count());
 }
 
 void Film::add(const dvec3* sums, const uint32_t* counts, const double* weights, const double* aov,
-               const double* alpha, const dvec3* splats, uint64_t nonfinite) {
+               const double* alpha, const dvec3* splats, uint64_t splat_paths, uint64_t nonfinite) {
     const size_t n = sum_.size();
     for (size_t i = 0; i < n; ++i) {
         sum_[i] += sums[i];
@@ -84,6 +84,7 @@ void Film::add(const dvec3* sums, const uint32_t* counts, const double* weights,
         if (splat_.empty()) splat_.assign(n, dvec3(0.0));
         for (size_t i = 0; i < n; ++i) splat_[i] += splats[i];
     }
+    splat_paths_ += splat_paths;
     nonfinite_.fetch_add(nonfinite, std::memory_order_relaxed);
 }
 
@@ -101,19 +102,27 @@ void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int m
     else alpha.clear();
 }
 
-void Film::add_splat(vec2 film_pos, vec3 L) {
-    int x = int(film_pos.x), y = int(film_pos.y);
-    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+void Film::add_splat(vec2 pos, vec3 L) {
+    if (!(pos.x >= 0.f && pos.y >= 0.f && pos.x < float(width_) && pos.y < float(height_))) return;
     if (!all_finite(L)) {
         nonfinite_.fetch_add(1, std::memory_order_relaxed);
         return;
     }
-    // Splats arrive from any thread to any pixel; they are rare enough for a lock here, and
-    // bidirectional integrators buffer them per thread before calling this.
-    static std::mutex m;
-    std::lock_guard<std::mutex> lock(m);
     if (splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
+    const int x = std::min(int(pos.x), width_ - 1), y = std::min(int(pos.y), height_ - 1);
     splat_[size_t(y) * size_t(width_) + size_t(x)] += dvec3(L);
+}
+
+void Film::add_splats(const SplatTile& t) {
+    if (!t.pixel.empty() && splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
+    for (size_t k = 0; k < t.pixel.size(); ++k) splat_[t.pixel[k]] += dvec3(t.value[k]);
+    splat_paths_ += t.paths;
+    if (t.nonfinite) nonfinite_.fetch_add(t.nonfinite, std::memory_order_relaxed);
+}
+
+void Film::restore_splats(std::vector<dvec3> sums, uint64_t paths) {
+    splat_ = std::move(sums);
+    splat_paths_ = paths;
 }
 
 vec3 Film::pixel(int x, int y) const {
@@ -121,7 +130,7 @@ vec3 Film::pixel(int x, int y) const {
     dvec3 v;
     if (weighted_) v = weight_[i] > 0.0 ? sum_[i] / weight_[i] : dvec3(0.0);
     else v = count_[i] > 0 ? sum_[i] / double(count_[i]) : dvec3(0.0);
-    if (!splat_.empty()) v += splat_[i] * splat_scale_;
+    v += splat_value(i);
     return vec3(v);
 }
 
@@ -169,6 +178,8 @@ void Film::restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64
     count_ = std::move(counts);
     weight_ = std::move(weights);
     nonfinite_ = nonfinite;
+    splat_.clear();
+    splat_paths_ = 0;
 }
 
 }  // namespace candela

@@ -66,9 +66,9 @@ public:
     void add(const Film& other);
     // The same from raw arrays of a film of this size and layout (an MPI layer message read in
     // place): `weights` when weighted, `aov` when aov_channels > 0, `alpha` when alpha is on;
-    // `splats` may be null (none).
+    // `splats` may be null (none); `splat_paths` light paths are counted either way.
     void add(const dvec3* sums, const uint32_t* counts, const double* weights, const double* aov, const double* alpha,
-             const dvec3* splats, uint64_t nonfinite);
+             const dvec3* splats, uint64_t splat_paths, uint64_t nonfinite);
     // Alpha (hdrfilm pixel_format rgba): per pixel, the fraction of its samples whose camera ray
     // hit a surface, as Mitsuba. Off (and not allocated) until enable_alpha; kept over resize.
     void enable_alpha();
@@ -79,8 +79,26 @@ public:
     const std::vector<double>& alpha_sums() const { return alpha_; }
     void restore_alpha(std::vector<double> sums);
 
-    // Splats are scaled by 1 / (passes) when resolved: splat_scale is set by the integrator.
-    void add_splat(vec2 film_pos, vec3 L);
+    // ---- Splats: contributions of light paths (light tracing, BDPT's t = 1), which land anywhere.
+    // They are summed per pixel in a buffer of their own (allocated when first used), beside the
+    // count of light paths traced (`splat_paths`), and a pixel resolves to
+    //     sum(samples) / count  +  splat_sum x N / splat_paths,
+    // N the number of pixels: each light path is a sample of the whole image (the camera's We is
+    // normalised over the image, scene/camera.h), so with one light path per pixel sample
+    // (splat_paths = spp x N) the splats are divided by the samples per pixel.
+    // Deterministic at any thread count: threads never touch the film's splats; each tile fills a
+    // SplatTile in its own sample order, and the pass merges the tiles in tile order (add_splats).
+    // add_splat and add_splats are NOT thread safe: one thread at a time.
+    void add_splat(vec2 image_pos, vec3 L);  // image pixels; outside the image: dropped
+    void add_splats(const struct SplatTile& tile);
+    bool has_splats() const { return !splat_.empty() || splat_paths_ > 0; }
+    uint64_t splat_paths() const { return splat_paths_; }
+    const std::vector<dvec3>& splat_sums() const { return splat_; }  // empty when none
+    // The splats' share of pixel i (row-major index), normalised as above.
+    dvec3 splat_value(size_t i) const {
+        return splat_.empty() || splat_paths_ == 0 ? dvec3(0.0) : splat_[i] * splat_norm();
+    }
+    void restore_splats(std::vector<dvec3> sums, uint64_t paths);
 
     // Mean radiance of a pixel (sum / count, or sum(w L) / sum(w) when weighted), plus splats.
     vec3 pixel(int x, int y) const;
@@ -98,16 +116,12 @@ public:
     // Total number of samples over all pixels.
     uint64_t total_samples() const;
 
-    void set_splat_scale(double s) { splat_scale_ = s; }
-
     // Raw state for checkpoints.
     const std::vector<dvec3>& sums() const { return sum_; }
     const std::vector<uint32_t>& counts() const { return count_; }
     const std::vector<double>& weights() const { return weight_; }  // weighted layout only
     const std::vector<double>& aov_sums() const { return aov_; }   // aov_channels per pixel
-    const std::vector<dvec3>& splats() const { return splat_; }    // empty until a splat
     void restore_aov(std::vector<double> sums) { aov_ = std::move(sums); }
-    void restore_splats(std::vector<dvec3> splats) { splat_ = std::move(splats); }
     // `weights` must be empty for an unweighted film and one per pixel for a weighted one.
     void restore(std::vector<dvec3> sums, std::vector<uint32_t> counts, uint64_t nonfinite,
                  std::vector<double> weights = {});
@@ -123,8 +137,35 @@ private:
     std::vector<dvec3> splat_;
     bool alpha_enabled_ = false;
     std::vector<double> alpha_;  // sums of coverage (0 or 1 per sample)
-    double splat_scale_ = 1.0;
+    uint64_t splat_paths_ = 0;
+    double splat_norm() const { return double(sum_.size()) / double(splat_paths_); }
     std::atomic<uint64_t> nonfinite_{0};
+};
+
+// A tile's splats in the order its light paths made them (pixel index, value), and how many light
+// paths it traced. Reused across tiles: clear() keeps the capacity.
+struct SplatTile {
+    std::vector<uint32_t> pixel;
+    std::vector<vec3> value;
+    uint64_t paths = 0;
+    uint64_t nonfinite = 0;
+    void clear() {
+        pixel.clear();
+        value.clear();
+        paths = 0;
+        nonfinite = 0;
+    }
+    // Image position (pixels) -> the pixel it lands in; outside the image or non-finite: dropped.
+    void add(int width, int height, vec2 pos, vec3 L) {
+        if (!(pos.x >= 0.f && pos.y >= 0.f && pos.x < float(width) && pos.y < float(height))) return;
+        if (!all_finite(L)) {
+            ++nonfinite;
+            return;
+        }
+        const int x = std::min(int(pos.x), width - 1), y = std::min(int(pos.y), height - 1);
+        pixel.push_back(uint32_t(y) * uint32_t(width) + uint32_t(x));
+        value.push_back(L);
+    }
 };
 
 // A tile's share of a weighted pass: the tile's pixels plus `margin` on each side (clipped to the

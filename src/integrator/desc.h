@@ -10,6 +10,7 @@ namespace candela {
 enum class IntegratorType {
     Path,    // path (and volpath in a scene without media): integrator/path/
     Direct,  // direct: integrator/direct/
+    Ptracer, // ptracer (light tracing, splats only): integrator/ptracer/
 };
 
 // Arbitrary output variables of Mitsuba's `aov` wrapper: values of the first surface the camera

@@ -1,12 +1,14 @@
 #include "integrator/integrator.h"
 #include "integrator/direct/direct.h"
 #include "integrator/path/path_pass.h"
+#include "integrator/ptracer/ptracer.h"
 
 namespace candela {
 
 std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
     switch (scene.settings.integrator.type) {
         case IntegratorType::Direct: return std::make_unique<DirectPass>();
+        case IntegratorType::Ptracer: return std::make_unique<LightTracerPass>();
         case IntegratorType::Path: break;
     }
     return std::make_unique<PathPass>();

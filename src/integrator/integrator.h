@@ -14,6 +14,7 @@ namespace candela {
 struct PassStats {
     uint64_t samples = 0;
     uint64_t rays = 0;
+    uint64_t splats = 0;    // light-path contributions added to the film's splats
     bool completed = true;  // false when cancelled part-way
 };
 

@@ -230,25 +230,26 @@ vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
     return emitter_radiance_[size_t(e)];
 }
 
-std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const {
-    if (choices_ == 0) return std::nullopt;
+bool LightSet::sample_position(float u_sel, vec2 u_pos, PositionSample& out) const {
+    if (choices_ == 0) return false;
     const float x = u_sel * float(choices_);
     uint32_t k = std::min(uint32_t(x), choices_ - 1);
     const float u1 = std::min(x - float(k), 0x1.fffffep-1f);
     if (!has_area() || k > 0) {
         if (has_area()) --k;
-        std::optional<EmissionSample> es = candela::sample_le(lights_[k].model, sphere_, u_pos, u_dir);
-        if (es) es->pdf_pos *= choice_pmf_;
-        return es;
+        if (light_flags(lights_[k].model) & (kLightDeltaPosition | kLightDeltaDirection)) return false;
+        out.light = int32_t(k);
+        out.pdf = choice_pmf_;
+        return true;
     }
     float pmf;
     size_t i = dist_.sample(u1, &pmf);
-    EmissionSample es;
-    es.flags = kLightArea;
-    vec3 p, err, ng, ns;
+    out.light = -1;
+    SurfaceInteraction& si = out.si;
     float area;
     if (i >= tris_.size()) {
-        const AnalyticShape& a = (*analytic_)[alights_[i - tris_.size()]];
+        const uint32_t ai = alights_[i - tris_.size()];
+        const AnalyticShape& a = (*analytic_)[ai];
         // Seen from inside a sphere, and from anywhere for a disk or cylinder, sample_analytic draws
         // uniformly by area (only its point is used here): from the centre, from a point on the
         // disk's axis, from the middle of the cylinder's axis.
@@ -256,44 +257,62 @@ std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 
         if (a.kind == PrimKind::Disk) ref = vec3(a.to_world[3]) + a.normal * std::sqrt(a.area);
         if (a.kind == PrimKind::Cylinder) ref = vec3(a.to_world * glm::vec4(0.f, 0.f, 0.5f * a.length, 1.f));
         AnalyticSample as;
-        if (!sample_analytic(a, ref, u_pos, as)) return std::nullopt;
-        p = as.p;
-        err = as.p_error;
-        ng = ns = as.n;
+        if (!sample_analytic(a, ref, u_pos, as)) return false;
+        si.p = as.p;
+        si.p_error = as.p_error;
+        si.ng = si.ns = as.n;
+        si.kind = a.kind;
+        si.prim = ai;
         area = a.area;
-        es.Le = emitter_radiance_[size_t(analytic_emitter_[alights_[i - tris_.size()]])];
+        out.Le = emitter_radiance_[size_t(analytic_emitter_[ai])];
     } else {
         uint32_t tri = tris_[i];
         vec3 p0, p1, p2;
         mesh_->vertices(tri, p0, p1, p2);
         vec2 b = square_to_uniform_triangle(u_pos);
-        interpolate_point(p0, p1, p2, b.x, b.y, 1.f - b.x - b.y, p, err);
-        ng = glm::cross(p1 - p0, p2 - p0);
+        interpolate_point(p0, p1, p2, b.x, b.y, 1.f - b.x - b.y, si.p, si.p_error);
+        vec3 ng = glm::cross(p1 - p0, p2 - p0);
         float len = glm::length(ng);
-        if (!(len > 0.f)) return std::nullopt;
-        ng /= len;
-        ns = ng;
+        if (!(len > 0.f)) return false;
+        si.ng = si.ns = ng / len;
         if (!mesh_->normals.empty()) {
             const uvec3& t = mesh_->triangles[tri];
             vec3 n = b.x * mesh_->normals[t.x] + b.y * mesh_->normals[t.y] + (1.f - b.x - b.y) * mesh_->normals[t.z];
-            if (glm::dot(n, n) > 0.f) ns = glm::normalize(n);
+            if (glm::dot(n, n) > 0.f) si.ns = glm::normalize(n);
         }
+        si.kind = PrimKind::Triangle;
+        si.prim = tri;
         area = area_[i];
-        es.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
-                                                            : radiance_[i];
+        out.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
+                                                             : radiance_[i];
     }
+    out.pdf = area_pmf_ * pmf / area;
+    return true;
+}
+
+std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const {
+    if (choices_ == 0) return std::nullopt;
+    const float x = u_sel * float(choices_);
+    const uint32_t k = std::min(uint32_t(x), choices_ - 1);
+    if (!has_area() || k > 0) {
+        const uint32_t j = has_area() ? k - 1 : k;
+        std::optional<EmissionSample> es = candela::sample_le(lights_[j].model, sphere_, u_pos, u_dir);
+        if (es) es->pdf_pos *= choice_pmf_;
+        return es;
+    }
+    PositionSample ps;
+    if (!sample_position(u_sel, u_pos, ps)) return std::nullopt;
+    EmissionSample es;
+    es.flags = kLightArea;
+    es.Le = ps.Le;
     // Cosine-distributed about the emitting side (the shading normal's, as emitted()).
     vec3 local = square_to_cosine_hemisphere(u_dir);
-    Frame f(ns);
+    Frame f(ps.si.ns);
     vec3 d = f.to_world(local);
     if (!(local.z > 0.f)) return std::nullopt;
-    SurfaceInteraction si;
-    si.p = p;
-    si.p_error = err;
-    si.ng = ng;
-    es.ray = spawn_ray(si, d);
-    es.n = ns;
-    es.pdf_pos = area_pmf_ * pmf / area;
+    es.ray = spawn_ray(ps.si, d);
+    es.n = ps.si.ns;
+    es.pdf_pos = ps.pdf;
     es.pdf_dir = square_to_cosine_hemisphere_pdf(local);
     return es;
 }

@@ -69,6 +69,19 @@ public:
     // chosen triangle or shape, a cosine-distributed direction on its emitting side. Returns
     // nothing when the scene has no light or the chosen one emits nothing there.
     std::optional<EmissionSample> sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const;
+    // A point on a light for a connection to the camera (the light tracer's emitters seen
+    // directly): u_sel picks the light as sample_le does. Area lights: a point uniform by area on
+    // the chosen triangle or shape, `pdf` its area density times the pmf, `Le` the radiance it
+    // emits on its front side (the side of si.ns). Infinite lights (constant, envmap): light >= 0
+    // names it and pdf is the pmf alone (the caller samples a direction). Delta lights: false.
+    struct PositionSample {
+        SurfaceInteraction si;
+        vec3 Le{0.f};
+        float pdf = 0.f;
+        int32_t light = -1;  // index into light(i) for the lights not on shapes
+    };
+    bool sample_position(float u_sel, vec2 u_pos, PositionSample& out) const;
+    float choice_pmf() const { return choice_pmf_; }
     // The densities sample_le gives to a ray leaving `on_light` (an area light's point) in w.
     void pdf_le(const SurfaceInteraction& on_light, vec3 w, float& pdf_pos, float& pdf_dir) const;
     // The densities sample_le gives to a ray of direction d from light i of light(i).

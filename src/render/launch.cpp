@@ -20,6 +20,13 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
     }
     // What the sampler stratifies over (a square, a power of two, ...), as the XML reader rounds it.
     if (ov.sampler || ov.sample_count) st.spp = int(sampler_sample_count(st.sampler.type, uint32_t(st.spp)));
+    if (ov.integrator) {
+        // Only the type changes: the scene's depths and hide_emitters stay (a direct scene keeps
+        // its max depth 1).
+        st.integrator.type = *ov.integrator;
+        if (*ov.integrator == IntegratorType::Ptracer && !st.integrator.aovs.empty())
+            throw Error("--integrator ptracer: the scene's aov or moment integrator needs camera rays, which ptracer has none of");
+    }
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
 }
@@ -30,6 +37,21 @@ std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneO
     SceneDescription desc = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
     apply_overrides(desc.settings, ov);
     return build_scene(std::move(desc), ov.accel);
+}
+
+IntegratorType parse_integrator_type(const std::string& s) {
+    if (s == "path") return IntegratorType::Path;
+    if (s == "direct") return IntegratorType::Direct;
+    if (s == "ptracer") return IntegratorType::Ptracer;
+    throw Error("unknown integrator '" + s + "' (expected path, direct or ptracer)");
+}
+
+const char* integrator_type_name(IntegratorType t) {
+    switch (t) {
+        case IntegratorType::Direct: return "direct";
+        case IntegratorType::Ptracer: return "ptracer";
+        default: return "path";
+    }
 }
 
 SamplingMode parse_sampling_mode(const std::string& s) {

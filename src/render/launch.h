@@ -16,6 +16,7 @@ struct SceneOverrides {
     std::optional<SamplingMode> sampling;
     std::optional<SamplerType> sampler;  // --sampler (jitter keeps the scene's)
     std::optional<int> sample_count;     // --sample-count: the scene's sample_count
+    std::optional<IntegratorType> integrator;  // --integrator: replaces the scene's <integrator>
     std::string accel = "auto";
 };
 
@@ -24,6 +25,8 @@ struct SceneOverrides {
 std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
+IntegratorType parse_integrator_type(const std::string& s);  // path | direct | ptracer
+const char* integrator_type_name(IntegratorType t);
 const char* sampling_mode_name(SamplingMode m);
 // --sampler NAME: a sampler_type_name; "orthogonal" and unknown names are errors.
 SamplerType parse_sampler_name(const std::string& s);

@@ -243,7 +243,7 @@ void RenderSession::worker() {
     int full_w = 0, full_h = 0, prev_w = 0, prev_h = 0;
     double render_time = 0, full_time = 0;
     double sec_per_sample = 0;  // measured, smoothed over passes: sizes the previews
-    uint64_t full_samples = 0, full_rays = 0;
+    uint64_t full_samples = 0, full_rays = 0, full_splats = 0;  // splats: ptracer
     auto last_tick = Clock::now();
 
     enum class Job { None, Preview, Full };
@@ -305,7 +305,7 @@ void RenderSession::worker() {
             need_preview = true;
             last_full_.clear();
             render_time = full_time = 0;
-            full_samples = full_rays = 0;
+            full_samples = full_rays = full_splats = 0;
             std::lock_guard<std::mutex> lock(mu_);
             stats_ = SessionStats();
             stats_.generation = gen;
@@ -342,12 +342,15 @@ void RenderSession::worker() {
         full_time += dt;
         full_samples += ps.samples;
         full_rays += ps.rays;
+        full_splats += ps.splats;
         publish(film, false, gen, passes, [&](SessionStats& s, double change) {
             s.passes = passes;
             s.spp = double(passes) * spp;
             s.elapsed = render_time;
             s.msamples_per_s = full_time > 0 ? double(full_samples) / full_time * 1e-6 : 0;
             s.mrays_per_s = full_time > 0 ? double(full_rays) / full_time * 1e-6 : 0;
+            s.splats = full_splats;
+            s.msplats_per_s = full_time > 0 ? double(full_splats) / full_time * 1e-6 : 0;
             s.nonfinite = full.nonfinite_count();
             s.preview = false;
             if (change < 0) return;

@@ -67,6 +67,8 @@ struct SessionStats {
     double spp = 0;           // samples per pixel in the full film
     double elapsed = 0;       // seconds of rendering since the restart (paused time excluded)
     double msamples_per_s = 0, mrays_per_s = 0;  // over the full passes of this generation
+    uint64_t splats = 0;        // light-path contributions splatted (ptracer), this generation
+    double msplats_per_s = 0;
     uint64_t nonfinite = 0;   // NaN/Inf samples dropped by the film (Film::nonfinite_count)
     bool paused = false, idle = false, preview = false;
     std::string error;        // why the last update() was refused (the render goes on without it)

@@ -21,6 +21,18 @@ inline mat4 look_at(vec3 origin, vec3 target, vec3 up) {
 
 enum class FovAxis { X, Y, Diagonal, Smaller, Larger };
 
+// A connection from a point of the scene to the camera (Camera::sample_wi): what light tracing
+// and BDPT's t = 1 strategy need. See "Importance" in Camera for the measures.
+struct CameraWiSample {
+    vec3 p{0.f};        // the point on the camera: the pinhole, a point of the lens, or of the
+                        // orthographic camera's film plane (world space)
+    vec3 wi{0.f};       // unit direction from the reference point towards p
+    float dist = 0.f;   // |p - ref|
+    float Wi = 0.f;     // We(p, -wi): the importance the camera emits towards the reference point
+    float pdf = 0.f;    // density of p, as seen from ref (see below); 0: no connection
+    vec2 raster{0.f};   // where the ray p -> ref lands on the image, in image pixels [0,W)x[0,H)
+};
+
 // The sensors of Mitsuba 3 that candela renders: a closed set chosen by a type field, so that ray
 // generation is one switch and no virtual call (src/sensors/perspective.cpp, thinlens.cpp and
 // orthographic.cpp in Mitsuba 3.9 define every convention below).
@@ -116,6 +128,49 @@ struct Camera {
     }
     Ray generate_ray(ivec2 px, vec2 jitter, vec2 lens) const { return generate_ray(film_position(px, jitter), lens); }
 
+    // ---- Importance (light tracing, BDPT; pbrt-v4's Camera::We / PDF_We / SampleWi) -----------
+    // The camera is a sensor whose response to radiance L is the image: pixel value
+    //   I_j = integral over camera points p and directions w of W_j(p, w) L(p, -w) |cos theta| dA(p) dw,
+    // theta the angle between w and the view axis. W_j = N We h_j with h_j the indicator of pixel
+    // j's area on the image and N the image's pixel count, so that a pixel is the mean radiance
+    // over its area; We is normalised over the IMAGE (the crop window, at the film's current size:
+    // set_film_size), i.e. integral of We(p, w) |cos theta| dA dw = 1, and zero for rays that leave
+    // the image. Consequently a light tracer that traces M light paths estimates pixel j by
+    // (N / M) x (sum of the splats that land in j) (film/film.h).
+    //   perspective:  We(w) = 1 / (A cos^4 theta), A the image's area on the plane z = 1 in camera
+    //                 space; the position is a delta (the pinhole, a "lens" of area 1).
+    //   thin lens:    We(p, w) = 1 / (A pi r^2 cos^4 theta), p uniform on the aperture disk of
+    //                 radius r; w leaves the image when the focal-plane point it reaches does.
+    //   orthographic: We(p, w) = delta(w - forward) / A_perp, A_perp the image's area on the film
+    //                 plane measured perpendicular to the view direction (world units).
+    // Rays start on the near clip plane and end on the far one (generate_ray), so a point is seen
+    // only with camera-space depth in [near_clip, far_clip].
+
+    // We of a ray leaving the camera (unit direction; its origin on the lens for a thin lens). The
+    // image position it reaches is written to `raster` (image pixels) when it is on the image.
+    // Orthographic: the positional density 1 / A_perp (the direction is a delta: only the camera's
+    // forward direction has importance; other directions return 0).
+    float We(const Ray& ray, vec2* raster = nullptr) const;
+    // pbrt-v4's PDF_We: the densities with which a camera ray sampled uniformly on the image (and
+    // the lens) has this origin (area measure; 1 for the pinhole's delta position, 1 / (pi r^2) on
+    // a lens, 1 / A_perp on the orthographic film plane) and this direction (solid angle: 1 /
+    // (A cos^3 theta) for perspective and thin lens; 1 for the orthographic delta direction).
+    // Both 0 when the ray leaves the image.
+    void pdf_We(const Ray& ray, float& pdf_pos, float& pdf_dir) const;
+    // Connects `ref` to the camera: p on the camera (the pinhole; a point of the lens drawn
+    // uniformly from u; the orthographic film plane's point straight before ref), its direction,
+    // and pdf = the density of p in SOLID ANGLE at ref: dist^2 / (|cos theta| lens_area) with
+    // lens_area = pi r^2 (thin lens) or 1 (pinhole, a delta: pdf is then that conversion only);
+    // orthographic: 1 (a delta in both). The light tracer's estimate of the connection is
+    //   beta f(ref, wi) |cos| Wi / pdf  (times the visibility of p from ref),
+    // which is We cos theta / dist^2 for the pinhole and 1 / A_perp for the orthographic camera.
+    // Returns false (and pdf 0) when ref is not seen: behind the camera, out of the clip range,
+    // or projecting outside the image.
+    bool sample_wi(vec3 ref, vec2 u, CameraWiSample& out) const;
+    // The image's area behind We's normalisation (A, or A_perp for the orthographic camera).
+    float importance_area() const { return importance_area_; }
+    float lens_area() const { return needs_lens_sample() ? kPi * aperture_radius * aperture_radius : 1.f; }
+
     // The camera's position (the pinhole, the lens centre, or the orthographic camera's to_world
     // origin).
     vec3 origin() const { return origin_; }
@@ -130,6 +185,16 @@ private:
     ivec2 seed_offset_{0};
     vec3 origin_{0.f};
     vec3 ortho_dir_{0.f, 0.f, 1.f};
+    // Importance: world -> camera space, the image size and its area (see We).
+    mat4 from_world_{1.f};
+    ivec2 image_size_{1};
+    float importance_area_ = 1.f;
+    // Image pixels of a camera-space direction through the pinhole plane z = 1 (perspective and
+    // thin lens: p1 = the point on z = 1) or of a camera-space point (orthographic).
+    vec2 raster_of_plane_point(vec2 p1) const;
+    bool on_image(vec2 raster) const {
+        return raster.x >= 0.f && raster.y >= 0.f && raster.x < float(image_size_.x) && raster.y < float(image_size_.y);
+    }
 };
 
 // Mitsuba's parse_fov: the horizontal field of view (degrees) of `fov_deg` along `axis` on a

@@ -62,6 +62,8 @@ void Viewer::panel() {
         ImGui::Text("%.0f spp  (%d passes)", stats.spp, stats.passes);
         ImGui::Text("%.2f s   %.3f Msamples/s   %.3f Mrays/s", stats.elapsed, stats.msamples_per_s,
                     stats.mrays_per_s);
+        if (stats.splats > 0)
+            ImGui::Text("splats  %llu   %.3f Msplats/s", (unsigned long long)stats.splats, stats.msplats_per_s);
         if (stats.nonfinite > 0) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.4f, 0.35f, 1.f));
         ImGui::Text("NaN/Inf samples: %llu", (unsigned long long)stats.nonfinite);
         if (stats.nonfinite > 0) ImGui::PopStyleColor();
@@ -87,6 +89,19 @@ void Viewer::panel() {
     // ---- what the image depends on: every change restarts the render
     if (ImGui::CollapsingHeader("Integrator", ImGuiTreeNodeFlags_DefaultOpen)) {
         RenderSettings& st = fe_->params().settings;
+        // Switches the running render: the next pass makes the new integrator (render_pass).
+        // The aov and moment wrappers need camera rays: ptracer is offered without them only.
+        const bool wrapped = !st.integrator.aovs.empty();
+        static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer};
+        int type = st.integrator.type == IntegratorType::Direct ? 1 : st.integrator.type == IntegratorType::Ptracer ? 2 : 0;
+        if (ImGui::Combo("integrator", &type, wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0")) {
+            st.integrator.type = kTypes[type];
+            fe_->params_changed(viewer_now());
+        }
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("path: path tracing with next-event estimation and MIS\n"
+                              "direct: direct lighting only (Mitsuba's direct)\n"
+                              "ptracer: light tracing, every light-path vertex splatted through the camera");
         int mode = int(st.sampling);
         if (ImGui::Combo("sampling", &mode, "light sampling\0BSDF sampling\0MIS\0")) {
             st.sampling = SamplingMode(mode);
@@ -114,7 +129,7 @@ void Viewer::panel() {
             st.rr_depth = std::max(0, st.rr_depth);
             fe_->params_changed(viewer_now());
         }
-        ImGui::Text("path tracer, accelerator: %s", fe_->scene().accel ? fe_->scene().accel->name().c_str() : "-");
+        ImGui::Text("accelerator: %s", fe_->scene().accel ? fe_->scene().accel->name().c_str() : "-");
     }
 
     if (ImGui::CollapsingHeader("Camera & display", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -548,7 +548,9 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
             sum += f->sums()[i];
         }
         if (total <= 0) continue;
+        // Splats (light tracing) are already normalised per film: weighted like the batch means.
         dvec3 m = sum / total;
+        for (const Film* f : batches) m += f->splat_value(i) * (norm(f, i) / total);
         im.mean[i] = m;
         // Weighted batch means: var(sum_k w_k m_k) estimated by K/(K-1) sum_k w_k^2 (m_k - m)^2,
         // which is s^2 / K for equal batches.
@@ -557,7 +559,7 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
             double c = norm(f, i);
             if (c <= 0) continue;
             double w = c / total;
-            dvec3 d = f->sums()[i] / c - m;
+            dvec3 d = f->sums()[i] / c + f->splat_value(i) - m;
             v += w * w * d * d;
         }
         im.var_of_mean[i] = v * (K / (K - 1.0));

@@ -87,6 +87,16 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         p.report_unused();
         return IntegratorRole::Renders;
     }
+    if (type == "ptracer") {
+        // Mitsuba's ptracer: light paths connected to the camera (integrator/ptracer/). Its
+        // samples_per_pass only splits Mitsuba's work into passes: the image does not depend on it.
+        read_depths(p, st);
+        d.type = IntegratorType::Ptracer;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.get_int("samples_per_pass", -1);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
     if (type == "moment") {
         // The image is the nested integrator's; the caller, which knows the nested integrator's
         // name, adds the moment channels (AovType::Moment) once the nesting is read.
@@ -100,7 +110,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, moment, aov)");
+                "' (candela supports: path, volpath, direct, ptracer, moment, aov)");
 }
 
 FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {

@@ -13,6 +13,9 @@ void load_integrator(XmlLoader& L, pugi::xml_node n) {
     for (int level = 0;; ++level) {
         Object o = L.read_object(n, "integrator");
         if (read_integrator(o.type, o.params, s, o.line) == IntegratorRole::Renders) {
+            // The light tracer's image is all splats: there is no camera ray to take AOVs or moments of.
+            if (s.integrator.type == IntegratorType::Ptracer && (level > 0 || !moment.empty()))
+                throw L.error(n, "ptracer cannot be nested in an aov or moment integrator (it traces no camera rays)");
             L.finish(o);
             break;
         }

@@ -1,0 +1,265 @@
+// The light tracer (integrator/ptracer/, Mitsuba 3's ptracer) and the film's splats.
+//
+//  * Ptracer_AgreesWithPath: the built-in Cornell box at max depth 0, 1, 2, 5 and unbounded, light
+//    tracing against path tracing, independent seeds (batch means: 8 batches each), block z-test
+//    (4 x 4 pixel blocks) and a whole-image z-test per channel, at alpha 0.01 Sidak-corrected over
+//    the depths. The light tracer is noisy here (the whole-image mean has a relative standard error
+//    of about 2-4% per depth at this budget), so this test has no 3% control of its own: the
+//    controls that show the light tracer's bias would be caught are those of the diffuse wall
+//    (3% brighter rejected, p = 7e-6) and of the furnace (3% off rejected, p < 1e-4).
+//  * Ptracer_VisibleDiffuseWall: a diffuse wall lit by a square lamp outside the view, where
+//    t = 1 alone is a whole estimator: the same tests against the path tracer.
+//  * Ptracer_Furnace: the closed diffuse sphere lit by its own emission (tests/test_furnace.cpp):
+//    every pixel's exact value is Le (1 - a^(d+1)) / (1 - a); z-test over the pixel means with a
+//    3%-off control rejected at the same level.
+//  * Determinism: 1 and 2 threads, and 4 passes of 1 spp against 1 pass of 4, give the same film
+//    bit for bit (splats included); checkpoint and resume through the program (--integrator
+//    ptracer) end bit for bit as the uninterrupted render.
+//  * XML: <integrator type="ptracer"> with Mitsuba's max_depth, and a ptracer inside aov refused.
+#include <gtest/gtest.h>
+#include <cstring>
+#include <map>
+#include "core/error.h"
+#include "film/image_io.h"
+#include "render/renderer.h"
+#include "scene/cornell.h"
+#include "scene/loaders.h"
+#include "support/run.h"
+#include "support/stats.h"
+
+using namespace candela;
+using namespace candela::stats;
+
+namespace {
+
+constexpr double kAlpha = 0.01;
+
+// K films of `spp` samples each, seeds base+1..base+K.
+ImageEstimate batches(const Scene& scene, SceneParams p, IntegratorType type, int K, int spp, uint64_t base) {
+    std::vector<std::unique_ptr<Film>> films;
+    std::vector<const Film*> ptrs;
+    p.settings.integrator.type = type;
+    auto sc = scene.with_params(p);
+    for (int b = 0; b < K; ++b) {
+        SceneParams q = p;
+        q.settings.seed = base + uint64_t(b) + 1;
+        films.push_back(std::make_unique<Film>(p.settings.width, p.settings.height));
+        Renderer::render_pass(*scene.with_params(q), *films.back(), 0, spp, 2);
+        ptrs.push_back(films.back().get());
+    }
+    return ImageEstimate::from_batches(ptrs);
+}
+
+ImageEstimate scaled(ImageEstimate e, double s) {
+    for (dvec3& m : e.mean) m *= s;
+    for (dvec3& v : e.var_of_mean) v *= s * s;
+    return e;
+}
+
+void compare(const ImageEstimate& lt, const ImageEstimate& pt, const std::string& what, int tests, bool control) {
+    const double level = sidak_level(kAlpha, tests);
+    BlockTestResult r = block_z_test(lt, pt, 4, level);
+    dvec3 rel;
+    const double p_whole = whole_image_p(lt, pt, &rel);
+    std::printf("  %-22s block %s\n  %-22s whole-image p = %.3g (rel %+.4f %+.4f %+.4f)\n", what.c_str(),
+                r.describe().c_str(), what.c_str(), p_whole, rel.x, rel.y, rel.z);
+    EXPECT_TRUE(r.passed(level)) << what << ": " << r.describe();
+    EXPECT_GE(p_whole, level) << what;
+    if (control) {
+        const double p_ctl = whole_image_p(scaled(lt, 1.03), pt);
+        std::printf("  %-22s control (3%% brighter): whole-image p = %.3g\n", what.c_str(), p_ctl);
+        EXPECT_LT(p_ctl, level) << what << ": the 3% brighter control is not rejected";
+    }
+}
+
+std::shared_ptr<const Scene> cornell(int res) {
+    SceneDescription d = make_cornell_box();
+    d.settings.width = d.settings.height = res;
+    return build_scene(std::move(d), "auto");
+}
+
+}  // namespace
+
+TEST(Ptracer, AgreesWithPathOnTheCornellBox) {
+    auto sc = cornell(16);
+    const std::vector<int> depths = {0, 1, 2, 5, -1};
+    for (int d : depths) {
+        SceneParams p = sc->params();
+        p.settings.max_depth = d;
+        ImageEstimate lt = batches(*sc, p, IntegratorType::Ptracer, 8, d == 0 ? 16 : 64, 100 + 10 * uint64_t(d + 1));
+        ImageEstimate pt = batches(*sc, p, IntegratorType::Path, 8, d == 0 ? 16 : 32, 200 + 10 * uint64_t(d + 1));
+        compare(lt, pt, "cornell depth " + std::to_string(d), int(depths.size()), false);
+    }
+}
+
+// A 4 x 4 diffuse wall at z = 0 facing +z, lit by a 1 x 1 lamp facing it from z = 2 (off to the
+// side, out of view), seen by a camera at z = 4 looking at the wall's centre.
+TEST(Ptracer, VisibleDiffuseWall) {
+    SceneDescription d;
+    d.source = "<diffuse wall>";
+    d.materials.push_back({"wall", DiffuseBsdf{vec3(0.7f, 0.5f, 0.3f)}, false});
+    d.materials.push_back({"lamp", DiffuseBsdf{vec3(0.f)}, false});
+    d.emitters.push_back({vec3(8.f)});
+    d.add_shape("wall", {vec3(-2, -2, 0), vec3(2, -2, 0), vec3(2, 2, 0), vec3(-2, 2, 0)}, {}, {uvec3(0, 1, 2), uvec3(0, 2, 3)},
+                0, -1);
+    // Centred at (2.5, 0, 2), tilted to face the wall's centre.
+    const vec3 c(2.5f, 0.f, 2.f), n = glm::normalize(-c), t = glm::normalize(glm::cross(n, vec3(0, 1, 0))),
+               b = glm::cross(t, n);
+    const vec3 q[4] = {c - 0.5f * t - 0.5f * b, c + 0.5f * t - 0.5f * b, c + 0.5f * t + 0.5f * b, c - 0.5f * t + 0.5f * b};
+    const bool faces = glm::dot(glm::cross(q[1] - q[0], q[2] - q[0]), n) > 0.f;
+    d.add_shape("lamp", {q[0], q[1], q[2], q[3]}, {}, faces ? std::vector<uvec3>{uvec3(0, 1, 2), uvec3(0, 2, 3)}
+                                                           : std::vector<uvec3>{uvec3(0, 2, 1), uvec3(0, 3, 2)}, 1, 0);
+    d.camera.to_world = look_at(vec3(0.f, 0.f, 4.f), vec3(0.f), vec3(0.f, 1.f, 0.f));
+    d.camera.fov_deg = 40.f;
+    d.settings.width = d.settings.height = 24;
+    auto sc = build_scene(std::move(d), "auto");
+    ImageEstimate lt = batches(*sc, sc->params(), IntegratorType::Ptracer, 8, 32, 300);
+    ImageEstimate pt = batches(*sc, sc->params(), IntegratorType::Path, 8, 32, 400);
+    compare(lt, pt, "diffuse wall", 1, true);
+}
+
+namespace {
+
+// tests/test_furnace.cpp's icosphere (one subdivision), wound so that the faces look inwards.
+void icosphere(std::vector<vec3>& out, std::vector<uvec3>& f) {
+    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+    std::vector<dvec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    for (dvec3& p : v) p = glm::normalize(p);
+    f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+         {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+        auto key = std::minmax(a, b);
+        auto it = mid.find(key);
+        if (it != mid.end()) return it->second;
+        v.push_back(glm::normalize(v[a] + v[b]));
+        return mid[key] = uint32_t(v.size() - 1);
+    };
+    std::vector<uvec3> g;
+    for (const uvec3& tri : f) {
+        uint32_t ab = midpoint(tri.x, tri.y), bc = midpoint(tri.y, tri.z), ca = midpoint(tri.z, tri.x);
+        g.insert(g.end(), {{tri.x, ab, ca}, {tri.y, bc, ab}, {tri.z, ca, bc}, {ab, bc, ca}});
+    }
+    f = g;
+    for (uvec3& tri : f)
+        if (glm::dot(glm::cross(v[tri.y] - v[tri.x], v[tri.z] - v[tri.x]), v[tri.x] + v[tri.y] + v[tri.z]) > 0)
+            std::swap(tri.y, tri.z);
+    for (const dvec3& p : v) out.push_back(vec3(p));
+}
+
+}  // namespace
+
+TEST(Ptracer, Furnace) {
+    const vec3 albedo(0.5f, 0.8f, 0.f);
+    const std::vector<int> depths = {1, -1};
+    const double level = sidak_level(kAlpha, int(depths.size()) * 3);
+    for (int depth : depths) {
+        SceneDescription d;
+        d.source = "<furnace>";
+        std::vector<vec3> pos;
+        std::vector<uvec3> f;
+        icosphere(pos, f);
+        d.materials.push_back({"inside", DiffuseBsdf{albedo}, false});
+        d.emitters.push_back({vec3(1.f)});
+        d.add_shape("sphere", pos, {}, f, 0, 0);
+        d.settings.width = d.settings.height = 16;
+        d.settings.max_depth = depth;
+        d.settings.integrator.type = IntegratorType::Ptracer;
+        d.settings.seed = uint64_t(7 + depth);
+        d.camera.to_world = look_at(vec3(0.f), vec3(0.f, 0.f, 1.f), vec3(0.f, 1.f, 0.f));
+        d.camera.fov_deg = 90.f;
+        d.camera.near_clip = 1e-3f;
+        d.camera.far_clip = 10.f;
+        auto sc = build_scene(std::move(d), "brute");
+        Film film(16, 16);
+        Renderer::render_pass(*sc, film, 0, 384, 2);
+        EXPECT_EQ(film.nonfinite_count(), 0u);
+        for (int k = 0; k < 3; ++k) {
+            RunningStats s;
+            for (int y = 0; y < 16; ++y)
+                for (int x = 0; x < 16; ++x) s.add(film.pixel(x, y)[k]);
+            const double a = albedo[k];
+            const double exact = depth < 0 ? 1.0 / (1.0 - a) : (1.0 - std::pow(a, depth + 1)) / (1.0 - a);
+            MeanTest t = z_test(s, exact, 1e-5 * exact);
+            MeanTest ctl = z_test(s, 1.03 * exact, 1e-5 * exact);
+            std::printf("  depth %2d a=%.1f  %s\n  control (3%% off): p = %.3g\n", depth, a, t.describe().c_str(),
+                        ctl.p_value);
+            EXPECT_GE(t.p_value, level) << "depth " << depth << " channel " << k << ": " << t.describe();
+            EXPECT_LT(t.std_error, 0.01 * exact) << "too noisy to reveal a bias";
+            EXPECT_LT(ctl.p_value, level) << "depth " << depth << " channel " << k << ": control not rejected";
+        }
+    }
+}
+
+TEST(Ptracer, SameFilmAtAnyThreadCountAndPassSplit) {
+    auto base = cornell(20);
+    SceneParams p = base->params();
+    p.settings.integrator.type = IntegratorType::Ptracer;
+    auto sc = base->with_params(p);
+    Film a(20, 20), b(20, 20), c(20, 20);
+    Renderer::render_pass(*sc, a, 0, 4, 1);
+    Renderer::render_pass(*sc, b, 0, 4, 2);
+    for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
+    ASSERT_FALSE(a.splat_sums().empty());
+    EXPECT_EQ(a.splat_paths(), 20u * 20u * 4u);
+    EXPECT_EQ(std::memcmp(a.splat_sums().data(), b.splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
+    EXPECT_EQ(std::memcmp(a.splat_sums().data(), c.splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
+    EXPECT_EQ(a.resolve(), b.resolve());
+    EXPECT_EQ(a.resolve(), c.resolve());
+    EXPECT_EQ(a.sample_count(3, 5), 4u);
+}
+
+TEST(Ptracer, CheckpointAndResumeKeepTheSplats) {
+    using namespace candela::test;
+    const std::string d = temp_dir("ptracer-ckpt"), o = "--width 20 --height 16 --quiet --integrator ptracer";
+    ASSERT_EQ(run_candela(o + " --frames 5 --out " + d + "/full.exr --checkpoint " + d + "/full.ck").exit_code, 0);
+    RunResult a = run_candela(o + " --frames 2 --threads 1 --out " + d + "/part.exr --checkpoint " + d + "/part.ck");
+    ASSERT_EQ(a.exit_code, 0) << a.output;
+    RunResult b = run_candela(o + " --frames 5 --threads 2 --out " + d + "/part.exr --checkpoint " + d + "/part.ck --resume " +
+                              d + "/part.ck");
+    ASSERT_EQ(b.exit_code, 0) << b.output;
+    EXPECT_TRUE(read_bytes(d + "/full.ck") == read_bytes(d + "/part.ck")) << "the checkpoints differ";
+    Image ia = read_linear_image(d + "/full.exr"), ib = read_linear_image(d + "/part.exr");
+    ASSERT_EQ(ia.rgb.size(), ib.rgb.size());
+    EXPECT_EQ(std::memcmp(ia.rgb.data(), ib.rgb.data(), ia.rgb.size() * sizeof(float)), 0);
+    double sum = 0;
+    for (float v : ia.rgb) sum += v;
+    EXPECT_GT(sum, 0.0);  // the image is the splats: not black
+    // A path-traced render refuses the light tracer's checkpoint (another integrator).
+    RunResult c = run_candela("--width 20 --height 16 --quiet --frames 6 --out " + d + "/x.exr --resume " + d + "/full.ck");
+    EXPECT_EQ(c.exit_code, 1) << c.output;
+    EXPECT_NE(c.output.find("another scene or other settings"), std::string::npos) << c.output;
+    // An unknown integrator is a one-line usage error.
+    RunResult e = run_candela("--integrator bdpt --out " + d + "/y.exr");
+    EXPECT_NE(e.exit_code, 0);
+    EXPECT_NE(e.output.find("--integrator"), std::string::npos) << e.output;
+}
+
+TEST(Ptracer, XmlIntegrator) {
+    using namespace candela::test;
+    const std::string d = temp_dir("ptracer-xml");
+    auto scene_with = [&](const std::string& integrator) {
+        return "<scene version=\"3.0.0\">" + integrator +
+               "<sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/>"
+               "<integer name=\"height\" value=\"8\"/></film></sensor>"
+               "<shape type=\"sphere\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape></scene>";
+    };
+    write_text(d + "/a.xml", scene_with("<integrator type=\"ptracer\"><integer name=\"max_depth\" value=\"3\"/>"
+                                        "<integer name=\"rr_depth\" value=\"2\"/><boolean name=\"hide_emitters\" value=\"true\"/>"
+                                        "</integrator>"));
+    SceneDescription s = load_scene(d + "/a.xml");
+    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Ptracer);
+    EXPECT_EQ(s.settings.max_depth, 2);  // Mitsuba's segments: 3 = two scattering events
+    EXPECT_EQ(s.settings.rr_depth, 2);
+    EXPECT_TRUE(s.settings.integrator.hide_emitters);
+    write_text(d + "/b.xml", scene_with("<integrator type=\"aov\"><string name=\"aovs\" value=\"dd:depth\"/>"
+                                        "<integrator type=\"ptracer\"/></integrator>"));
+    try {
+        load_scene(d + "/b.xml");
+        ADD_FAILURE() << "ptracer inside aov accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("ptracer cannot be nested"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("b.xml"), std::string::npos) << e.what();
+    }
+}
