@@ -6,6 +6,7 @@
 #ifdef CANDELA_HAS_MPI
 #include <gtest/gtest.h>
 #include <cstdio>
+#include <filesystem>
 #include <cstring>
 #include <regex>
 #include <sstream>
@@ -237,6 +238,11 @@ TEST(Mpi, TimeLimitAndSetupErrors) {
     size_t first = bad.output.find("missing.xml");
     ASSERT_NE(first, std::string::npos) << bad.output;
     EXPECT_EQ(bad.output.find("candela:", bad.output.find("candela:") + 1), std::string::npos) << bad.output;
+    // Adaptive sampling's decision half is not in the layers: refused in one line, nothing written.
+    RunResult adaptive = run_mpi(2, "--width 16 --height 16 --threads 1 --quiet --target-error 0.1 --out " + d + "/a.exr");
+    EXPECT_NE(adaptive.exit_code, 0);
+    EXPECT_NE(adaptive.output.find("--target-error is not available under MPI"), std::string::npos) << adaptive.output;
+    EXPECT_FALSE(std::filesystem::exists(d + "/a.exr"));
 }
 
 #endif  // CANDELA_HAS_MPI

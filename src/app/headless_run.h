@@ -22,6 +22,10 @@ struct HeadlessOptions {
     std::string checkpoint;
     double checkpoint_every = 60;
     std::string resume;
+    // Adaptive sampling (docs/adaptive.md): > 0 stops each pixel once its estimated relative error
+    // is below target_error (after adaptive_min_spp samples), and the render when all have stopped.
+    double target_error = 0;
+    int adaptive_min_spp = 16;
 };
 
 // Renders the passes, shows progress (a bar on a terminal, a summary line otherwise), and writes

@@ -41,6 +41,15 @@ int main(int argc, char** argv) {
     app.add_option("--threads", opt.threads, "Render threads (default: all cores)")->check(CLI::Range(0, 1024));
     app.add_option("--time-limit", opt.time_limit, "Stop after this many seconds (the image has the passes done by then)")
         ->check(CLI::PositiveNumber);
+    auto* te_opt = app.add_option("--target-error", opt.target_error,
+                                  "Headless: adaptive sampling; stop each pixel once the estimated relative error of\n"
+                                  "its luminance is below E, and the render when all have stopped (the scene's\n"
+                                  "sample count and --time-limit are the other bounds; docs/adaptive.md)")
+                      ->type_name("E")
+                      ->check(CLI::PositiveNumber);
+    app.add_option("--adaptive-min-spp", opt.adaptive_min_spp, "Samples a pixel takes before it may stop (default 16)")
+        ->check(CLI::Range(4, 1 << 24))
+        ->needs(te_opt);
     app.add_option("--exposure", opt.display.exposure, "Exposure in stops for PNG output and the viewer");
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
     std::string integrator;
@@ -117,6 +126,7 @@ int main(int argc, char** argv) {
 #ifdef CANDELA_HAS_VIEWER
         if (opt.out.empty() && (has_display || *shot)) {
             if (*ck_opt || *resume_opt) throw Error("--checkpoint and --resume are for headless renders: give --out");
+            if (*te_opt) throw Error("--target-error is for headless renders: give --out");
             ViewerOptions vo;
             vo.scene = opt.scene;
             vo.overrides = ov;
@@ -138,6 +148,7 @@ int main(int argc, char** argv) {
 #else
         (void)shot;
         (void)resume_opt;
+        (void)te_opt;
         (void)prio_opt;
 #endif
         if (opt.out.empty()) {

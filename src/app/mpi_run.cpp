@@ -277,6 +277,9 @@ int run_headless_mpi(const HeadlessOptions& opt) {
             check_writable(opt.out);
             if (!opt.checkpoint.empty()) check_writable(opt.checkpoint);
         }
+        // The layers carry the image half only, not adaptive sampling's decision half.
+        if (opt.target_error > 0)
+            throw Error("--target-error is not available under MPI (docs/adaptive.md): render without it, or in one process");
         scene_ptr = prepare_scene(opt.scene, opt.overrides);
         const RenderSettings& st = scene_ptr->settings;
         chunk = uint32_t(std::max(1, opt.spp_per_frame));

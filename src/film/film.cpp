@@ -15,7 +15,17 @@ void Film::resize(int width, int height) {
     splat_.clear();
     splat_paths_ = 0;
     if (alpha_enabled_) alpha_.assign(sum_.size(), 0.0);
+    if (adaptive_) enable_adaptive();
     nonfinite_ = 0;
+}
+
+void Film::enable_adaptive() {
+    adaptive_ = true;
+    const size_t n = sum_.size();
+    decision_count_.assign(n, 0u);
+    lum_.assign(2 * n, 0.0);
+    lum2_.assign(2 * n, 0.0);
+    active_.assign(n, 1);
 }
 
 void Film::enable_alpha() {
@@ -169,6 +179,7 @@ std::vector<float> Film::resolve() const {
 uint64_t Film::total_samples() const {
     uint64_t n = 0;
     for (uint32_t c : count_) n += c;
+    for (uint32_t c : decision_count_) n += c;
     return n;
 }
 

@@ -112,8 +112,50 @@ public:
     std::vector<float> resolve() const;
     void resolve_into(std::vector<float>& rgb) const;
 
+    // Adaptive sampling (film/adaptive.h, docs/adaptive.md), unweighted layout only. Two halves:
+    // samples of even sample index go to the decision half, which keeps only the sum and the sum
+    // of squares of their luminance and is never averaged into the image; samples of odd index go
+    // to the image (sum_, count_, as add_sample) and also keep their luminance moments (for the
+    // naive-rule control of the tests). A pixel whose decision half says it has converged is
+    // marked inactive and the tile loop skips it. Its stopping time depends on the even samples
+    // only, which are independent of the odd ones, so the image stays unbiased.
+    void enable_adaptive();
+    bool adaptive() const { return adaptive_; }
+    bool active(int x, int y) const { return active_[size_t(y) * size_t(width_) + size_t(x)] != 0; }
+    void set_active(int x, int y, bool a) { active_[size_t(y) * size_t(width_) + size_t(x)] = a ? 1 : 0; }
+    // A sample of pixel px with sample index `index` (its parity picks the half).
+    void add_adaptive_sample(ivec2 px, vec3 L, uint32_t index) {
+        size_t i = size_t(px.y) * size_t(width_) + size_t(px.x);
+        if (!all_finite(L)) {
+            nonfinite_.fetch_add(1, std::memory_order_relaxed);
+            L = vec3(0.f);
+        }
+        const unsigned h = index & 1u;
+        if (h) {
+            sum_[i] += dvec3(L);
+            count_[i] += 1;
+        } else {
+            decision_count_[i] += 1;
+        }
+        const double y = double(luminance(L));
+        lum_[2 * i + h] += y;
+        lum2_[2 * i + h] += y * y;
+    }
+    // Luminance moments of half h (0: decision, 1: image) of a pixel: count, sum, sum of squares.
+    uint32_t half_count(int x, int y, int h) const {
+        size_t i = size_t(y) * size_t(width_) + size_t(x);
+        return h ? count_[i] : decision_count_[i];
+    }
+    double half_lum_sum(int x, int y, int h) const { return lum_[2 * (size_t(y) * size_t(width_) + size_t(x)) + size_t(h)]; }
+    double half_lum_sq(int x, int y, int h) const { return lum2_[2 * (size_t(y) * size_t(width_) + size_t(x)) + size_t(h)]; }
+    // Samples taken in the pixel, both halves (sample_count is the image's share when adaptive).
+    uint32_t samples_taken(int x, int y) const {
+        size_t i = size_t(y) * size_t(width_) + size_t(x);
+        return count_[i] + (adaptive_ ? decision_count_[i] : 0u);
+    }
+
     uint64_t nonfinite_count() const { return nonfinite_.load(std::memory_order_relaxed); }
-    // Total number of samples over all pixels.
+    // Total number of samples over all pixels (both halves when adaptive).
     uint64_t total_samples() const;
 
     // Raw state for checkpoints.
@@ -140,6 +182,10 @@ private:
     uint64_t splat_paths_ = 0;
     double splat_norm() const { return double(sum_.size()) / double(splat_paths_); }
     std::atomic<uint64_t> nonfinite_{0};
+    bool adaptive_ = false;
+    std::vector<uint32_t> decision_count_;
+    std::vector<double> lum_, lum2_;  // 2 per pixel: the decision half, the image half
+    std::vector<uint8_t> active_;
 };
 
 // A tile's splats in the order its light paths made them (pixel index, value), and how many light

@@ -117,6 +117,9 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
     };
 
     if (!film.weighted()) {
+        // Adaptive sampling (film/adaptive.h): pixels the stopping rule marked inactive between
+        // passes are skipped; a sample's index parity picks its half of the film.
+        const bool adaptive = film.adaptive();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
         for (int tile = 0; tile < n_tiles; ++tile) {
             if (cancelled()) continue;
@@ -127,6 +130,7 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
             const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x) {
+                    if (adaptive && !film.active(x, y)) continue;
                     for (int s = 0; s < spp; ++s) {
                         // Sampler dimensions of a camera sample: the pixel jitter (2), the lens (2, a
                         // thin lens with an aperture only), then the integrator's.
@@ -137,6 +141,11 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                         if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
                         const uint64_t hits = ps.camera_hits;
                         vec3 L = li(sampler, ray, ps);
+                        if (adaptive) {
+                            film.add_adaptive_sample(ivec2(x, y), L, first_sample + uint32_t(s));
+                            ++samples;
+                            continue;  // no AOVs nor alpha (refused with --target-error)
+                        }
                         film.add_sample(ivec2(x, y), L);
                         if (moment_at >= 0) write_moment(aov + moment_at, all_finite(L) ? L : vec3(0.f));
                         if (alpha) film.add_coverage(ivec2(x, y), ps.camera_hits != hits);
