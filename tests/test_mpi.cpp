@@ -26,17 +26,8 @@ const std::string kBox = "--width 32 --height 32 --threads 1 --seed 3 --quiet";
 
 // candela under mpirun with `np` ranks; `env` ("NAME=value ...") reaches every rank.
 RunResult run_mpi(int np, const std::string& args, const std::string& env = "") {
-    std::string cmd = "env -u DISPLAY -u WAYLAND_DISPLAY " + env + " " + kMpirun + " -np " + std::to_string(np) + " " +
-                      CANDELA_BIN + " " + args + " 2>&1";
-    RunResult r;
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    int status = pclose(p);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return r;
+    return run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " + env + " " + kMpirun + " -np " + std::to_string(np) + " " +
+                     CANDELA_BIN + " " + args);
 }
 
 bool same_file(const std::string& a, const std::string& b) {

@@ -111,19 +111,6 @@ bool file_exists_plain(const std::string& path) {
     return stat(path.c_str(), &st) == 0;
 }
 
-// Runs `command` with /bin/sh, stdout and stderr together.
-RunResult run_shell(const std::string& command) {
-    RunResult r;
-    FILE* p = popen((command + " 2>&1").c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    int status = pclose(p);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return r;
-}
-
 // An X display number with no server behind it (no socket in /tmp/.X11-unix).
 int unused_display() {
     for (int n = 87; n < 200; ++n)

@@ -13,11 +13,10 @@ struct RunResult {
     std::string output;  // stdout and stderr together
 };
 
-// `env` adds variables ("NAME=value ..."), after DISPLAY and WAYLAND_DISPLAY are removed.
-inline RunResult run_candela(const std::string& args, const std::string& env = "") {
-    std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + env + " " + CANDELA_BIN + " " + args + " 2>&1";
+// Runs `command` with /bin/sh, stdout and stderr together.
+inline RunResult run_shell(const std::string& command) {
     RunResult r;
-    FILE* p = popen(cmd.c_str(), "r");
+    FILE* p = popen((command + " 2>&1").c_str(), "r");
     if (!p) return r;
     char buf[4096];
     size_t n;
@@ -25,6 +24,11 @@ inline RunResult run_candela(const std::string& args, const std::string& env = "
     int status = pclose(p);
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     return r;
+}
+
+// `env` adds variables ("NAME=value ..."), after DISPLAY and WAYLAND_DISPLAY are removed.
+inline RunResult run_candela(const std::string& args, const std::string& env = "") {
+    return run_shell(std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + env + " " + CANDELA_BIN + " " + args);
 }
 
 // A fresh scratch directory for one test (removed by the caller if it wants to).
