@@ -10,9 +10,11 @@
 #               Debug run is for assertions and code that -O3 could hide. CANDELA_DEBUG_EXCLUDE=REGEX
 #               replaces the regex (an empty value runs everything). See docs/reliability.md.
 #   --sanitize  the ASan+UBSan build in build-asan/ (MPI off: Open MPI's own leaks are not ours),
-#               every test (about 7x the Release suite's CPU
-#               time, see docs/reliability.md); CANDELA_ASAN_EXCLUDE=REGEX leaves tests out
-#               (ctest -E), e.g. '^(BsdfChi2|ImageCornell|KdTree)\.' for a quick local run
+#               every test but the 17 longest statistical and brute-force ones (5-40 s each in
+#               Release, 5-7x that instrumented): each repeats, with more samples, code that a
+#               lighter test of the same family runs instrumented (list and reasons in
+#               docs/reliability.md). CANDELA_ASAN_EXCLUDE=REGEX replaces the list (an empty
+#               value runs everything).
 #   --tsan      a ThreadSanitizer build in build-tsan/, the render session and the viewer's use of it
 #               without a window (Session.*, ViewerFrontEnd.*, SceneSplit.*), with
 #               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
@@ -31,7 +33,7 @@ case "$mode" in
   --debug)
     dir=$(bash scripts/build.sh --debug | tail -n 1)
     cd "$dir"
-    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox))\.?'
+    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)|Filters\.EachFilterMatchesMitsuba|BsdfWeights\.RoughPlasticWeightIsBounded|SceneSplit\.TheCoatCacheKeepsOnlyTablesInUse|BsdfFurnace|MeshFormatsRender|Microfacet\.VisibleNormal|Emitters\.MitsubaAgreement|Instancing\.(MemoryGrows|HitsAgree|MitsubaAgreement)|BsdfWrappers\.(BlendSampling|MitsubaAgreement)|BsdfMitsuba\.[A-Za-z]*Render|PrincipledMitsuba\.RenderAgreement|AnalyticShapes\.MitsubaAgreement|Texture\.MitsubaAgreement|Envmap\.(ImageMatchesMitsuba|SampleLiMatchesPdfLi)|Direct\.(ExactIrradiance|MatchesMitsuba)|Adaptive\.CornellImage|Bdpt\.(AgreesWith|Furnace|Unweighted))\.?'
     exclude=${CANDELA_DEBUG_EXCLUDE-$heavy}
     ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
     ;;
@@ -46,7 +48,8 @@ case "$mode" in
     # LeakSanitizer runs, so no suppression can name it: it runs with leak checking off (memory
     # errors and UB are still fatal).
     viewer='^ViewerWindow\.'
-    exclude=${CANDELA_ASAN_EXCLUDE:-}
+    long='^(Mis\.|BsdfChi2\.SamplingMatchesPdf$|PrincipledChi2\.SamplingMatchesPdf$|KdTree\.(DragonMatchesBruteForce|BunnyMatchesBruteForce|CoherentOriginsMatchBruteForce)$|Filters\.EachFilterMatchesMitsuba$|BsdfWeights\.RoughPlasticWeightIsBounded$|PrincipledMitsuba\.AlbedoAgrees$|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)$|Furnace\.EverySampler$|ImageCornell\.EverySamplerMatchesMitsubaReference$|Cameras\.(Perspective|Orthographic)MatchesMitsubaReference$)'
+    exclude=${CANDELA_ASAN_EXCLUDE-$long}
     ctest --output-on-failure -j"$(nproc)" --timeout 1800 -E "${exclude:+$exclude|}$viewer"
     ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --output-on-failure --timeout 1800 -R "$viewer"
     ;;
