@@ -108,7 +108,7 @@ void Viewer::panel() {
             fe_->params_changed(viewer_now());
         }
         int sampler = int(st.sampler.type);
-        if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0")) {
+        if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0orthogonal\0")) {
             st.sampler.type = SamplerType(sampler);
             fe_->params_changed(viewer_now());
         }
