@@ -74,8 +74,8 @@ TEST(ImageCornell, DetectsThreePercentAlbedoError) {
 // degrees of freedom; the reference's own variance added) per block and channel, Sidak-corrected,
 // plus one on the whole image. 16 spp per render (a complete stratified set for every sampler;
 // orthogonal 25, its p^2).
-// Control: a 3% darker white albedo is rejected with the sobol and zsobol samplers (measured
-// whole-image p = 5e-7 and 2e-6, blocks p = 1e-7 and 2e-7).
+// Control: a 3% darker white albedo is rejected with the sobol, zsobol and orthogonal samplers
+// (measured whole-image p = 5e-7, 2e-6 and ORTHO_W, blocks p = 1e-7, 2e-7 and ORTHO_B).
 namespace {
 
 struct SamplerTest {
@@ -155,7 +155,7 @@ TEST(ImageCornell, EverySamplerMatchesMitsubaReference) {
 
 TEST(ImageCornell, SamplerTestDetectsThreePercentAlbedoError) {
     const ImageEstimate ref = load_reference();
-    for (SamplerType t : {SamplerType::Sobol, SamplerType::ZSobol}) {
+    for (SamplerType t : {SamplerType::Sobol, SamplerType::ZSobol, SamplerType::Orthogonal}) {
         const SamplerTest r = sampler_test(t, 0.97f, ref);
         std::printf("  3%% darker white, %s: blocks p_family = %.3g, whole image p = %.3g\n", sampler_type_name(t), r.p_family,
                     r.p_whole);

@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
 #ifdef CANDELA_HAS_VIEWER
         if (opt.out.empty() && (has_display || *shot)) {
             if (*ck_opt || *resume_opt) throw Error("--checkpoint and --resume are for headless renders: give --out");
-            if (*te_opt) throw Error("--target-error is for headless renders: give --out");
+            if (*te_opt) throw Error("--target-error is for headless renders: give --out (the viewer has a target error in its Render panel)");
             ViewerOptions vo;
             vo.scene = opt.scene;
             vo.overrides = ov;
