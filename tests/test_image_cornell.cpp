@@ -75,7 +75,7 @@ TEST(ImageCornell, DetectsThreePercentAlbedoError) {
 // plus one on the whole image. 16 spp per render (a complete stratified set for every sampler;
 // orthogonal 25, its p^2).
 // Control: a 3% darker white albedo is rejected with the sobol, zsobol and orthogonal samplers
-// (measured whole-image p = 5e-7, 2e-6 and ORTHO_W, blocks p = 1e-7, 2e-7 and ORTHO_B).
+// (measured whole-image p = 5e-7, 2e-6 and 3e-7, blocks p = 1e-7, 2e-7 and 5e-8).
 namespace {
 
 struct SamplerTest {
