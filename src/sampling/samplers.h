@@ -358,7 +358,6 @@ public:
         const float x = coordinate(c, c + 1);
         return vec2(x, coordinate(c + 1, c));
     }
-    uint32_t resolution() const { return p_; }
 
 private:
     void new_group() {
