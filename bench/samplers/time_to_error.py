@@ -17,12 +17,15 @@ reference's own expected MSE (Mitsuba independent's MSE at the first level times
 Time per sample: the fastest render time over seeds and levels, per sample. The spp needed for
 the target error E is interpolated on log RMSE against log N between the bracketing levels
 (extrapolated from the last two when outside), and the time to E = that spp x time per spp.
-E defaults to candela independent's RMSE at the second level. Stratified samplers render one
+E defaults to candela independent's RMSE at the last level. --table-only re-prints the table of
+the last run (its rows.json in --cache), e.g. with another --target; --retime R adds R rounds of
+timing in which every renderer and sampler renders ~256 spp in turn (the least time per spp seen
+is kept), so that a load that changed during the run does not favour one renderer. Stratified samplers render one
 complete set of N in candela (sample_count = N); Mitsuba renders in passes of 64 (the tool's
 bound on llvm memory; 49 for orthogonal), each pass its own complete set, as its renders would.
 Wall times on a shared machine vary by +-30%: read the time columns with that in mind.
 """
-import argparse, math, os, re, subprocess, sys, tempfile
+import argparse, json, math, os, re, subprocess, sys
 import numpy as np
 
 TOOLS = "/work/shared/tools"
@@ -106,14 +109,14 @@ def curve(args, renderer, sampler, ref, ref_mse):
 
 
 def spp_for(pts, e):
-    """spp at which RMSE reaches e: log-log interpolation between the bracketing levels."""
-    for (n0, e0), (n1, e1) in zip(pts, pts[1:]):
-        if e1 <= e <= e0 or (n1, e1) == pts[-1]:
-            a = math.log(e1 / e0) / math.log(n1 / n0)
-            if a >= 0:
-                return math.nan
-            return n0 * math.exp(math.log(e / e0) / a)
-    return math.nan
+    """spp at which RMSE reaches e: log-log interpolation between the bracketing levels, else
+    extrapolation from the nearest two."""
+    k = 0
+    while k + 2 < len(pts) and pts[k + 1][1] > e:
+        k += 1
+    (n0, e0), (n1, e1) = pts[k], pts[k + 1]
+    a = math.log(e1 / e0) / math.log(n1 / n0)
+    return n0 * math.exp(math.log(e / e0) / a) if a < 0 else math.nan
 
 
 def main():
@@ -124,13 +127,25 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--levels", default="64,256,1024")
-    ap.add_argument("--target", type=float, default=0, help="RMSE to reach (0: candela independent's at level 2)")
+    ap.add_argument("--target", type=float, default=0, help="RMSE to reach (0: candela independent's at the last level)")
     ap.add_argument("--candela-samplers", default=",".join(CANDELA))
     ap.add_argument("--mitsuba-samplers", default=",".join(MITSUBA))
     ap.add_argument("--cache", default="/tmp/candela-tte-bench")
+    ap.add_argument("--table-only", action="store_true")
+    ap.add_argument("--retime", type=int, default=0, metavar="R",
+                    help="R more timing rounds over the last run's rows (interleaved), then the table")
     args = ap.parse_args()
     args.levels = [int(x) for x in args.levels.split(",")]
     os.makedirs(args.cache, exist_ok=True)
+    if args.table_only or args.retime:
+        d = json.load(open(f"{args.cache}/rows.json"))
+        sys.path.insert(0, TOOLS)
+        for _ in range(args.retime):
+            retime(args, d["rows"])
+        with open(f"{args.cache}/rows.json", "w") as f:
+            json.dump(d, f)
+        print_table(args, d["rows"], d["ref_rmse"] ** 2)
+        return
     sys.path.insert(0, TOOLS)
     ref_path = f"{args.cache}/ref_{args.res}_{args.ref_spp}.npy"
     if not os.path.exists(ref_path):
@@ -151,7 +166,27 @@ def main():
                 continue
             pts, per_spp = curve(args, renderer, s, ref, ref_mse)
             rows.append((renderer, s, pts, per_spp))
-    target = args.target or dict(((r, s), p) for r, s, p, _ in rows)[("candela", "independent")][1][1]
+    with open(f"{args.cache}/rows.json", "w") as f:
+        json.dump({"rows": rows, "ref_rmse": math.sqrt(ref_mse)}, f)
+    print_table(args, rows, ref_mse)
+
+
+def retime(args, rows):
+    """One round of timing, every renderer and sampler in turn (so that both see the same load):
+    a render of about 256 spp; the time per spp kept is the least seen."""
+    for row in rows:
+        renderer, sampler = row[0], row[1]
+        n = level(renderer, sampler, 256)
+        if renderer == "candela":
+            _, t = candela_render(args, sampler, 99, n, f"{args.cache}/t_{sampler}.pfm")
+        else:
+            _, t = mitsuba_render(args, sampler, 99, n)
+        row[3] = min(row[3], t / n)
+        print(f"  time {renderer} {sampler}: {args.res * args.res * n / t * 1e-6:.2f} Msamples/s", file=sys.stderr, flush=True)
+
+
+def print_table(args, rows, ref_mse):
+    target = args.target or dict(((r, s), p) for r, s, p, _ in rows)[("candela", "independent")][-1][1]
     base = None
     print(f"Cornell box {args.res}x{args.res}, {args.threads} threads, {args.seeds} seeds per level, reference Mitsuba "
           f"independent {args.ref_spp} spp (its RMSE {math.sqrt(ref_mse):.5f}, taken out); "
