@@ -9,6 +9,7 @@
 #include "film/adaptive.h"
 #include "film/exr_layers.h"
 #include "film/image_io.h"
+#include "film/pass_halves.h"
 #include "render/renderer.h"
 #include "scene/cornell.h"
 #include "support/run.h"
@@ -214,4 +215,61 @@ TEST(Adaptive, CornellImageAgreesWithAPlainRender) {
     EXPECT_LT(pc, 1e-4);
     std::printf("adaptive vs plain p = %.3g (%.1f spp on average); 3%% brighter p = %.3g\n", p,
                 double(taken) / (4.0 * 32 * 32), pc);
+}
+
+// The viewer's estimate (film/pass_halves.h) on synthetic passes whose error is known: 256 x 256
+// pixels of means mu in [0.5, 2], each pass one sample mu (1 + u), u uniform on [-1/2, 1/2], so the
+// relative error of a pixel after K passes is 1 / sqrt(12 K). K = 31 (halves of 16 and 15 passes).
+// e^2 is a mean over the N pixels of f (a - b)^2 / m^2, each term about true^2 chi^2_1, so its
+// standard error is true^2 sqrt(2 / N); m in the denominator adds 3 / (12 K) to first order, which
+// the expectation includes. z-test; control: an estimate 3% too high (in e) is rejected. Also a
+// weighted film (exact values) and reset. Measured (fixed seed): z = -1.34, control z = -12.5.
+TEST(Adaptive, PassHalvesEstimateTheImageError) {
+    constexpr int kRes = 256, kPasses = 31;
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<double> u(-0.5, 0.5), mu_d(0.5, 2.0);
+    std::vector<double> mu(size_t(kRes * kRes));
+    for (double& m : mu) m = mu_d(rng);
+    Film film(kRes, kRes);
+    PassHalvesError est;
+    EXPECT_LT(est.relative_rms(film), 0.0);
+    for (int k = 0; k < kPasses; ++k) {
+        for (int y = 0; y < kRes; ++y)
+            for (int x = 0; x < kRes; ++x) film.add_sample(ivec2(x, y), vec3(float(mu[size_t(y * kRes + x)] * (1.0 + u(rng)))));
+        est.add_pass(film, k);
+        if (k == 0) {
+            EXPECT_LT(est.relative_rms(film), 0.0);  // one half only
+        }
+    }
+    EXPECT_EQ(est.passes(0), 16);
+    EXPECT_EQ(est.passes(1), 15);
+    const double truth2 = 1.0 / (12.0 * kPasses), expected2 = truth2 * (1.0 + 3.0 / (12.0 * kPasses));
+    const double se2 = truth2 * std::sqrt(2.0 / double(kRes * kRes));
+    const double e = est.relative_rms(film);
+    const double z = (e * e - expected2) / se2, zc = (e * e - expected2 * 1.03 * 1.03) / se2;
+    std::printf("  estimate %.5f, true %.5f: z = %.2f; 3%% high: z = %.2f\n", e, std::sqrt(truth2), z, zc);
+    EXPECT_LT(std::abs(z), 4.0);
+    EXPECT_GT(std::abs(zc), 4.0);
+    // A weighted film (the tile-merge path): one sample per pixel centre per pass, so the same
+    // numbers; the normaliser is the weight sum.
+    Film w(16, 16);
+    w.set_layout(true, 0);
+    PassHalvesError ew;
+    for (int k = 0; k < 2; ++k) {
+        FilmTile t;
+        t.reset(w, 0, 0, 16, 16, 0);
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) {
+                t.sum[size_t(y * 16 + x)] = dvec3(k == 0 ? 2.0 : 4.0);  // weight 2: values 1 and 2
+                t.weight[size_t(y * 16 + x)] = 2.0;
+                w.count_sample(ivec2(x, y));
+            }
+        w.merge(t);
+        ew.add_pass(w, k);
+    }
+    // a = 1, b = 2, m = 1.5, f = 1/4: e = 0.5 / 1.5 everywhere.
+    EXPECT_NEAR(ew.relative_rms(w), 0.5 / 1.5, 1e-12);
+    // reset: no estimate until both halves have a pass again.
+    ew.reset();
+    EXPECT_LT(ew.relative_rms(w), 0.0);
 }

@@ -238,10 +238,11 @@ TEST(Furnace, EverySampler) {
                 c.seed = uint64_t(100 + s);
                 auto d = furnace_description(c);
                 d->settings.sampler.type = SamplerType(t);
-                d->settings.spp = 16;
+                const int spp = int(sampler_sample_count(SamplerType(t), 16));  // a whole set (orthogonal: 25)
+                d->settings.spp = spp;
                 auto sc = build_scene(std::move(*d), "brute");
                 Film film(16, 16);
-                Renderer::render_pass(*sc, film, 0, 16, 2);
+                Renderer::render_pass(*sc, film, 0, spp, 2);
                 dvec3 sum(0.0);
                 for (int y = 0; y < 16; ++y)
                     for (int x = 0; x < 16; ++x) sum += dvec3(film.pixel(x, y));

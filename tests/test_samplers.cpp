@@ -161,6 +161,70 @@ TEST(Samplers, StratifiedSetsAreStratified) {
     EXPECT_EQ(sampler_sample_count(SamplerType::Sobol, 10), 10u);
 }
 
+// orthogonal (strength 2, n = p^2): every dimension is a Latin hypercube (one point in each of the
+// n 1D strata) and every pair of dimensions of one array (group of p + 1 dimensions, a 2D draw
+// never straddling two) is stratified on the p x p grid, for p = 2, 3, 5, with and without jitter,
+// in the first and second sets. Control: pairs from different groups (independent arrays) are not
+// all stratified, and independent points fail (StratifiedSetsAreStratified).
+TEST(Samplers, OrthogonalArraysAreStratified) {
+    const std::vector<int> pattern = {2, 1, 2, 2, 1, 1, 2, 1, 2};  // 14 dimensions: several groups for every p
+    for (uint32_t p : {2u, 3u, 5u}) {
+        const uint32_t n = p * p;
+        EXPECT_EQ(sampler_sample_count(SamplerType::Orthogonal, n), n);
+        // Group of each dimension, by the rule of the sampler's comment.
+        std::vector<int> group;
+        int g = -1;
+        uint32_t col = p + 1;
+        for (int w : pattern) {
+            if (col + uint32_t(w) > p + 1) ++g, col = 0;
+            col += uint32_t(w);
+            for (int k = 0; k < w; ++k) group.push_back(g);
+        }
+        for (bool jitter : {true, false})
+            for (uint32_t set = 0; set < 2; ++set) {
+                SamplerSetup st = setup(SamplerType::Orthogonal, n, 11);
+                st.desc.jitter = jitter;
+                OrthogonalSampler s(st);
+                std::vector<std::vector<float>> dims(group.size());
+                for (uint32_t i = set * n; i < (set + 1) * n; ++i) {
+                    s.start_pixel_sample(ivec2(4, 7), i);
+                    size_t d = 0;
+                    for (int w : pattern) {
+                        if (w == 2) {
+                            const vec2 q = s.next_2d();
+                            dims[d++].push_back(q.x);
+                            dims[d++].push_back(q.y);
+                        } else {
+                            dims[d++].push_back(s.next_1d());
+                        }
+                    }
+                }
+                int cross_stratified = 0, cross = 0;
+                for (size_t a = 0; a < dims.size(); ++a) {
+                    std::vector<vec2> xa;
+                    for (float v : dims[a]) xa.push_back(vec2(v, 0.f));
+                    EXPECT_TRUE(one_per_cell(xa, n, 1)) << "p " << p << " dimension " << a;
+                    for (size_t b = a + 1; b < dims.size(); ++b) {
+                        std::vector<vec2> ab;
+                        for (uint32_t i = 0; i < n; ++i) ab.push_back(vec2(dims[a][i], dims[b][i]));
+                        const bool ok = one_per_cell(ab, p, p);
+                        if (group[a] == group[b]) {
+                            EXPECT_TRUE(ok) << "p " << p << " dimensions " << a << ", " << b;
+                        } else {
+                            ++cross;
+                            cross_stratified += ok;
+                        }
+                    }
+                }
+                EXPECT_LT(cross_stratified, cross) << "p " << p << ": the groups' arrays are not independent";
+            }
+    }
+    EXPECT_EQ(sampler_sample_count(SamplerType::Orthogonal, 1), 4u);
+    EXPECT_EQ(sampler_sample_count(SamplerType::Orthogonal, 10), 25u);
+    EXPECT_EQ(sampler_sample_count(SamplerType::Orthogonal, 26), 49u);
+    EXPECT_EQ(sampler_sample_count(SamplerType::Orthogonal, 50), 121u);
+}
+
 // zsobol: the samples of an aligned quad of pixels are one block of the sequence, so the 4 spp of
 // a 4 x 4-pixel quad together form a (0, 6, 2)-net (blue noise across pixels), in later draws too
 // (the per-dimension digit permutations keep blocks), and each pixel's own 4 samples a (0, 2, 2)-

@@ -219,7 +219,7 @@ TEST(SceneXml, SamplerPlugins) {
     ASSERT_EQ(a.warnings.size(), 1u);
     EXPECT_NE(a.warnings[0].find("smp.xml:"), std::string::npos) << a.warnings[0];
     EXPECT_NE(a.warnings[0].find("rounded up to 16"), std::string::npos) << a.warnings[0];
-    const std::pair<const char*, int> cases[] = {{"multijitter", 12}, {"ldsampler", 16}, {"sobol", 10}, {"zsobol", 16}};
+    const std::pair<const char*, int> cases[] = {{"multijitter", 12}, {"ldsampler", 16}, {"sobol", 10}, {"zsobol", 16}, {"orthogonal", 25}};
     for (const auto& [name, spp] : cases) {
         SceneDescription b = load(std::string("<sampler type=\"") + name + "\"><integer name=\"sample_count\" value=\"10\"/></sampler>");
         SamplerType t;
@@ -435,8 +435,8 @@ TEST(SceneXml, Errors) {
     expect_error("<sensor type=\"perspective\"/>\n<sensor type=\"perspective\"/>\n", 3, "more than one <sensor>");
     expect_error("<shape type=\"rectangle\" color=\"red\"/>\n", 2, "unexpected attribute 'color'");
     expect_error("<sensor type=\"perspective\">\n<sampler type=\"halton\"/></sensor>\n", 3, "unsupported sampler type");
-    expect_error("<sensor type=\"perspective\">\n<sampler type=\"orthogonal\"/></sensor>\n", 3,
-                 "sampler 'orthogonal' is not supported");
+    expect_error("<sensor type=\"perspective\">\n<sampler type=\"orthogonal\"><integer name=\"strength\" value=\"3\"/>"
+                 "</sampler></sensor>\n", 3, "only strength 2 is supported");
     expect_error("<sensor type=\"perspective\">\n<sampler type=\"sobol\"><boolean name=\"jitter\" value=\"false\"/>"
                  "</sampler></sensor>\n", 3, "unused parameter 'jitter'");
     expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\"><integer name=\"width\" value=\"0\"/></film></sensor>\n", 3,

@@ -350,3 +350,40 @@ TEST(Session, AnEditThatDoesNotFitIsRefused) {
     EXPECT_EQ(session.scene()->materials.size(), scene->materials.size());
     EXPECT_EQ(image_sum(session.latest_full_image()), before);  // the same samples of the same scene
 }
+
+// A target error stops the full passes once the estimated error (from the even and odd passes) is
+// below it, without a restart; a lower target resumes the render, 0 renders on for ever. The
+// estimate is published after every pass from the second on, and falls as passes accumulate.
+TEST(Session, TargetErrorStopsTheRender) {
+    SessionOptions opt;
+    opt.threads = 2;
+    opt.spp_per_pass = 2;
+    RenderSession session(cornell(32, 24), opt);
+    session.set_target_error(0.5);
+    auto wait_reached = [&] {
+        for (int i = 0; i < 6000 && !(session.stats().target_reached && session.stats().idle); ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        return session.stats().target_reached && session.stats().idle;
+    };
+    ASSERT_TRUE(wait_reached());
+    SessionStats st = session.stats();
+    EXPECT_GE(st.passes, 2);
+    EXPECT_GE(st.estimate, 0.0);
+    EXPECT_LT(st.estimate, 0.5);
+    EXPECT_EQ(st.estimates.size(), size_t(st.passes - 1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    EXPECT_EQ(session.stats().passes, st.passes);  // stopped
+    // A lower target: the same generation renders on until it is reached too.
+    const double lower = st.estimate / 1.5;
+    session.set_target_error(lower);
+    ASSERT_TRUE(wait_reached());
+    SessionStats st2 = session.stats();
+    EXPECT_EQ(st2.generation, st.generation);
+    EXPECT_GT(st2.passes, st.passes);
+    EXPECT_LT(st2.estimate, lower);
+    EXPECT_LT(st2.estimates.back(), st2.estimates.front());
+    // No target: renders on.
+    session.set_target_error(0);
+    EXPECT_FALSE(session.stats().target_reached);
+    ASSERT_TRUE(session.wait_for(st2.generation, st2.passes + 2, 60));
+}

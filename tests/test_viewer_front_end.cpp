@@ -141,3 +141,22 @@ TEST(ViewerFrontEnd, TheWindowThreadNeverPreparesBsdfTables) {
     ASSERT_TRUE(rendered.prepared());
     EXPECT_EQ(rendered.tables->alpha, edited.alpha);
 }
+
+// The front end's statistics carry the estimated error for the panel's plot, and the panel's
+// target (set on the session) stops the render: the window's loop sees "target reached".
+TEST(ViewerFrontEnd, TargetErrorReachesThePanel) {
+    ViewerFrontEnd fe(cornell(24), options(), {});
+    fe.session().set_target_error(0.4);
+    ASSERT_TRUE(frames_until(fe, [&] { return fe.stats().target_reached && fe.stats().idle; }));
+    EXPECT_GE(fe.stats().estimate, 0.0);
+    EXPECT_LT(fe.stats().estimate, 0.4);
+    EXPECT_FALSE(fe.stats().estimates.empty());
+    // An edit restarts: the new render starts without an estimate and stops at the target again.
+    fe.params().settings.max_depth = 2;
+    fe.params_changed(now());
+    ASSERT_TRUE(frames_until(fe, [&] {
+        return fe.image().generation >= fe.sent_generation() && fe.stats().generation >= fe.sent_generation() &&
+               fe.stats().target_reached && fe.stats().idle;
+    }));
+    EXPECT_LT(fe.stats().estimate, 0.4);
+}

@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
                                        "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"
-                                       "sobol (Owen-scrambled per pixel) or zsobol (Z-order blue noise); docs/samplers.md");
+                                       "sobol (Owen-scrambled per pixel), zsobol (Z-order blue noise) or orthogonal\n"
+                                       "(orthogonal arrays, p^2 spp); docs/samplers.md");
     auto* count_opt = app.add_option("--sample-count", sample_count,
                                      "The scene's sample_count (overrides it): the default total spp, and what the\n"
                                      "stratified samplers stratify over (rounded up as the sampler needs)")
@@ -126,7 +127,7 @@ int main(int argc, char** argv) {
 #ifdef CANDELA_HAS_VIEWER
         if (opt.out.empty() && (has_display || *shot)) {
             if (*ck_opt || *resume_opt) throw Error("--checkpoint and --resume are for headless renders: give --out");
-            if (*te_opt) throw Error("--target-error is for headless renders: give --out");
+            if (*te_opt) throw Error("--target-error is for headless renders: give --out (the viewer has a target error in its Render panel)");
             ViewerOptions vo;
             vo.scene = opt.scene;
             vo.overrides = ov;

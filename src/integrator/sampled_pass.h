@@ -30,6 +30,10 @@ extern template PassStats render_pass_for<PathIntegrator, ZSobolSampler>(const S
                                                          const std::atomic<bool>*);
 extern template PassStats render_pass_for<DirectIntegrator, ZSobolSampler>(const Scene&, Film&, uint32_t, int, int,
                                                          const std::atomic<bool>*);
+extern template PassStats render_pass_for<PathIntegrator, OrthogonalSampler>(const Scene&, Film&, uint32_t, int, int,
+                                                         const std::atomic<bool>*);
+extern template PassStats render_pass_for<DirectIntegrator, OrthogonalSampler>(const Scene&, Film&, uint32_t, int, int,
+                                                         const std::atomic<bool>*);
 
 template <class S>
 struct SamplerTag {
@@ -49,6 +53,7 @@ PassStats render_sampled_pass(const Scene& scene, Film& film, uint32_t first_sam
         case SamplerType::LdSampler: return pass(SamplerTag<LdSampler>{});
         case SamplerType::Sobol: return pass(SamplerTag<SobolSampler>{});
         case SamplerType::ZSobol: return pass(SamplerTag<ZSobolSampler>{});
+        case SamplerType::Orthogonal: return pass(SamplerTag<OrthogonalSampler>{});
         case SamplerType::Independent: break;
     }
     return pass(SamplerTag<IndependentSampler>{});

@@ -64,8 +64,7 @@ SamplingMode parse_sampling_mode(const std::string& s) {
 SamplerType parse_sampler_name(const std::string& s) {
     SamplerType t;
     if (parse_sampler_type(s, t)) return t;
-    if (s == "orthogonal") throw Error("sampler 'orthogonal' is not supported by candela (use multijitter, ldsampler or sobol)");
-    throw Error("unknown sampler '" + s + "' (expected independent, stratified, multijitter, ldsampler, sobol or zsobol)");
+    throw Error("unknown sampler '" + s + "' (expected independent, stratified, multijitter, ldsampler, sobol, zsobol or orthogonal)");
 }
 
 const char* sampling_mode_name(SamplingMode m) {

@@ -138,6 +138,15 @@ void RenderSession::set_paused(bool on) {
     cv_.notify_all();
 }
 
+void RenderSession::set_target_error(double e) {
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        target_error_ = e;
+        stats_.target_reached = e > 0 && stats_.estimate >= 0 && stats_.estimate < e;
+    }
+    cv_.notify_all();
+}
+
 int RenderSession::threads() const {
     int n = threads_.load();
     return n > 0 ? n : omp_get_max_threads();
@@ -253,6 +262,7 @@ void RenderSession::worker() {
         if (interactive_) return preview_passes < kMaxPreviewPasses ? Job::Preview : Job::None;
         if (paused_.load()) return Job::None;
         if (opt_.max_passes > 0 && passes >= opt_.max_passes) return Job::None;
+        if (stats_.target_reached) return Job::None;
         return Job::Full;
     };
 
@@ -304,6 +314,7 @@ void RenderSession::worker() {
             passes = preview_passes = 0;
             need_preview = true;
             last_full_.clear();
+            halves_.reset();
             render_time = full_time = 0;
             full_samples = full_rays = full_splats = 0;
             std::lock_guard<std::mutex> lock(mu_);
@@ -338,6 +349,8 @@ void RenderSession::worker() {
             publish(film, true, gen, preview_passes, [&](SessionStats& s, double) { s.elapsed = render_time; });
             continue;
         }
+        halves_.add_pass(film, passes);
+        const double estimate = halves_.relative_rms(film);
         ++passes;
         full_time += dt;
         full_samples += ps.samples;
@@ -353,6 +366,17 @@ void RenderSession::worker() {
             s.msplats_per_s = full_time > 0 ? double(full_splats) / full_time * 1e-6 : 0;
             s.nonfinite = full.nonfinite_count();
             s.preview = false;
+            if (estimate >= 0) {
+                s.estimate = estimate;
+                const double target = target_error_.load();
+                s.target_reached = target > 0 && estimate < target;
+                if (s.estimates.size() >= kMaxHistory) {
+                    decimate(s.estimates);
+                    decimate(s.estimate_time);
+                }
+                s.estimates.push_back(float(estimate));
+                s.estimate_time.push_back(float(render_time));
+            }
             if (change < 0) return;
             if (s.change.size() >= kMaxHistory) {
                 decimate(s.change);

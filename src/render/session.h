@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 #include "film/film.h"
+#include "film/pass_halves.h"
 #include "scene/scene.h"
 
 namespace candela {
@@ -75,6 +76,13 @@ struct SessionStats {
     // Convergence: after every full pass k >= 2, the mean over pixels of |L_k - L_{k-1}| / (L_{k-1} + eps)
     // on luminance, with the time it was measured (seconds since the restart).
     std::vector<float> change, change_time;
+    // The estimated error of the image (film/pass_halves.h: RMS over pixels of the relative
+    // standard error, from the even and odd passes) after every full pass k >= 2, its history
+    // (estimate_time: seconds since the restart), and whether it fell below the target error
+    // (set_target_error), which stops the full passes.
+    double estimate = -1;  // -1: not yet (fewer than 2 passes)
+    std::vector<float> estimates, estimate_time;
+    bool target_reached = false;
 };
 
 class RenderSession {
@@ -108,6 +116,10 @@ public:
     // still restart and render one preview, so that the image shows them.
     void set_paused(bool on);
     bool paused() const { return paused_.load(); }
+    // Full passes stop once the estimated error (SessionStats::estimate) is below `e` (<= 0: never).
+    // Does not restart: a lower target resumes the render where it stopped.
+    void set_target_error(double e);
+    double target_error() const { return target_error_.load(); }
     // Thread count for the next pass; does not change the image (it does not depend on it).
     void set_threads(int n) { threads_.store(n); }
     int threads() const;
@@ -140,6 +152,7 @@ private:
     std::atomic<bool> cancel_{false};
     std::atomic<bool> paused_{false};
     std::atomic<int> threads_{0};
+    std::atomic<double> target_error_{0.0};
 
     mutable std::mutex mu_;  // guards everything below
     std::condition_variable cv_;
@@ -159,6 +172,7 @@ private:
     // The worker's own buffers (no lock): the next image to publish, the previous full pass.
     SessionImage back_;
     std::vector<float> last_full_;
+    PassHalvesError halves_;
 };
 
 // Mean relative change of luminance between two RGB images of the same size, over pixels where

@@ -4,7 +4,8 @@ namespace candela {
 
 namespace {
 constexpr const char* kNames[kSamplerTypeCount] = {"independent", "stratified", "multijitter",
-                                                   "ldsampler",   "sobol",      "zsobol"};
+                                                   "ldsampler",   "sobol",      "zsobol",
+                                                   "orthogonal"};
 }
 
 const char* sampler_type_name(SamplerType t) { return kNames[int(t)]; }
@@ -36,6 +37,16 @@ uint32_t sampler_sample_count(SamplerType t, uint32_t n) {
             uint32_t p = 1;
             while (p < n) p <<= 1;
             return p;
+        }
+        case SamplerType::Orthogonal: {
+            auto prime = [](uint32_t x) {
+                for (uint32_t d = 2; d * d <= x; ++d)
+                    if (x % d == 0) return false;
+                return true;
+            };
+            uint32_t p = 2;
+            while (p * p < n || !prime(p)) ++p;
+            return p * p;
         }
         default: return n;
     }

@@ -320,6 +320,67 @@ private:
     uint64_t salt_ = 0, base_ = 0;
 };
 
+// Mitsuba's `orthogonal` (Jarosz et al. 2019, "Orthogonal array sampling for Monte Carlo
+// rendering"), strength 2: n' = p^2, p the smallest prime with p^2 >= n. Row r of the sample (a
+// random permutation of its index in the set) is the pair (a0, a1) = (r / p, r % p); the Bose array
+// gives it p + 1 columns, a1 and a0 + l a1 mod p for l = 0..p-1, any two of which take every pair
+// of values once over the n' rows (p prime). Dimension k of a group is column k: its stratum of p is
+// a random permutation of that column's value and its sub-stratum of p one of another column's
+// (correlated multi-jitter: a 2D draw's x and y take each other's), so every dimension is a Latin
+// hypercube in n' strata and every pair of dimensions of a group is stratified on the p x p grid.
+// The array has p + 1 columns only; a draw that does not fit starts the next group, a fresh array
+// (own row permutation; a 2D draw never straddles two). Mitsuba instead wraps l mod p, so that its
+// dimensions repeat past p + 1. jitter as for stratified.
+class OrthogonalSampler final : public PixelSampleBase {
+public:
+    explicit OrthogonalSampler(const SamplerSetup& s)
+        : PixelSampleBase(s.seed), jitter_(s.desc.jitter),
+          n_(sampler_sample_count(SamplerType::Orthogonal, s.sample_count)) {
+        p_ = 2;
+        while (p_ * p_ < n_) ++p_;
+    }
+    void start_pixel_sample(ivec2 pixel, uint32_t i) {
+        start(pixel, i);
+        set_ = i / n_;
+        member_ = i % n_;
+        group_ = ~0u;  // no group yet: the first draw starts group 0
+        col_ = p_ + 1;
+    }
+    float next_1d() {
+        if (col_ + 1 > p_ + 1) new_group();
+        const uint32_t c = col_++;
+        return coordinate(c, c == 0 ? 1 : c - 1);
+    }
+    vec2 next_2d() {
+        if (col_ + 2 > p_ + 1) new_group();
+        const uint32_t c = col_;
+        col_ += 2;
+        const float x = coordinate(c, c + 1);
+        return vec2(x, coordinate(c + 1, c));
+    }
+
+private:
+    void new_group() {
+        ++group_;
+        const uint32_t gseed = uint32_t(mix_bits(key_ ^ (((uint64_t(set_) << 32) | group_) * 0xbf58476d1ce4e5b9ULL)) >> 16);
+        const uint32_t r = sampler_detail::permute(member_, n_, gseed);
+        a0_ = r / p_;
+        a1_ = r % p_;
+        col_ = 0;
+    }
+    // Column c of the row: c = 1 is a1, else a0 + l a1 with l = 0 (c = 0) or c - 1.
+    uint32_t column(uint32_t c) const { return c == 1 ? a1_ : (a0_ + (c == 0 ? 0 : c - 1) * a1_) % p_; }
+    float coordinate(uint32_t c, uint32_t sub) {
+        const uint32_t seed = next_dim_seed(set_);
+        const uint32_t stratum = sampler_detail::permute(column(c), p_, seed * 0x51633e2du + 1u);
+        const uint32_t substratum = sampler_detail::permute(column(sub), p_, seed * 0x68bc21ebu + 2u);
+        const float j = jitter_ ? rng().next_float() : 0.5f;
+        return sampler_detail::below_one((float(stratum) + (float(substratum) + j) / float(p_)) / float(p_));
+    }
+    bool jitter_;
+    uint32_t n_, p_ = 2, set_ = 0, member_ = 0, group_ = 0, col_ = 0, a0_ = 0, a1_ = 0;
+};
+
 // The sampler of type S for a setup.
 template <class S>
 S make_sampler(const SamplerSetup& s) {
@@ -339,6 +400,7 @@ decltype(auto) visit_sampler(const SamplerSetup& s, F&& f) {
         case SamplerType::LdSampler: return f(LdSampler(s));
         case SamplerType::Sobol: return f(SobolSampler(s));
         case SamplerType::ZSobol: return f(ZSobolSampler(s));
+        case SamplerType::Orthogonal: return f(OrthogonalSampler(s));
         case SamplerType::Independent: break;
     }
     return f(IndependentSampler(s.seed));

@@ -58,7 +58,7 @@ void Viewer::panel() {
         }
         ImGui::SameLine();
         const bool done = stats.idle || (opt_.screenshot_after > 0 && stats.passes >= opt_.screenshot_after);
-        ImGui::TextDisabled(paused ? "paused" : stats.preview ? "preview" : done ? "done" : "rendering");
+        ImGui::TextDisabled(paused ? "paused" : stats.preview ? "preview" : stats.target_reached ? "target error reached" : done ? "done" : "rendering");
         ImGui::Text("%.0f spp  (%d passes)", stats.spp, stats.passes);
         ImGui::Text("%.2f s   %.3f Msamples/s   %.3f Mrays/s", stats.elapsed, stats.msamples_per_s,
                     stats.mrays_per_s);
@@ -76,6 +76,18 @@ void Viewer::panel() {
         if (ImGui::IsItemHovered())
             ImGui::SetTooltip("Mean relative change of the image per pass, log10, over render time.\n"
                               "Monte Carlo noise falls as 1/sqrt(spp): the curve flattens as it converges.");
+        std::vector<float> est = resample_log(stats.estimates, stats.estimate_time, 120);
+        std::snprintf(overlay, sizeof overlay, stats.estimate >= 0 ? "est. error %.2e" : "est. error: 2 passes", stats.estimate);
+        ImGui::PlotLines("##estimate", est.empty() ? nullptr : est.data(), int(est.size()), 0, overlay, FLT_MAX, FLT_MAX,
+                         ImVec2(ImGui::GetContentRegionAvail().x, 56.f));
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Estimated error of the image, log10, over render time: the RMS over pixels of the\n"
+                              "relative standard error, from the difference of the even and the odd passes\n"
+                              "(unbiased with the independent sampler; docs/adaptive.md).");
+        float target = float(fe_->session().target_error());
+        if (ImGui::InputFloat("target error", &target, 0.f, 0.f, "%.4f")) fe_->session().set_target_error(std::max(0.f, target));
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Full passes stop once the estimated error is below this (0: never). No restart.");
         int max_threads = int(std::max(1u, std::thread::hardware_concurrency()));
         if (ImGui::SliderInt("threads", &threads_, 1, max_threads)) fe_->session().set_threads(threads_);
         ImGui::InputText("##png", png_path_, sizeof png_path_);
@@ -108,7 +120,7 @@ void Viewer::panel() {
             fe_->params_changed(viewer_now());
         }
         int sampler = int(st.sampler.type);
-        if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0")) {
+        if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0orthogonal\0")) {
             st.sampler.type = SamplerType(sampler);
             fe_->params_changed(viewer_now());
         }

@@ -25,7 +25,7 @@ void make_hdrfilm(XmlLoader& L, Object& o, RenderSettings& s) {
 }
 
 // The sampler plugins: sample_count and seed for all (Mitsuba's defaults 4 and 0), jitter for the
-// stratified ones; sobol and zsobol are candela's own (docs/samplers.md). The sample count is
+// stratified ones (and strength for orthogonal); sobol and zsobol are candela's own (docs/samplers.md). The sample count is
 // rounded up to what the sampler stratifies over, as Mitsuba does (a warning says so).
 void read_sampler(XmlLoader& L, Object& o, RenderSettings& s, SamplerType type) {
     int spp = o.params.get_int("sample_count", 4);
@@ -34,8 +34,12 @@ void read_sampler(XmlLoader& L, Object& o, RenderSettings& s, SamplerType type) 
     if (seed < 0) throw o.params.error("seed", "seed must not be negative");
     s.sampler = SamplerDesc();
     s.sampler.type = type;
-    if (type == SamplerType::Stratified || type == SamplerType::Multijitter)
+    if (type == SamplerType::Stratified || type == SamplerType::Multijitter || type == SamplerType::Orthogonal)
         s.sampler.jitter = o.params.get_bool("jitter", true);
+    // Mitsuba's strength other than 2 (Bush's construction) loses the 2D stratification its
+    // documentation recommends it for; candela has the strength-2 (Bose) array only.
+    if (type == SamplerType::Orthogonal && o.params.get_int("strength", 2) != 2)
+        throw o.params.error("strength", "orthogonal sampler: only strength 2 is supported");
     const uint32_t rounded = sampler_sample_count(type, uint32_t(spp));
     if (rounded != uint32_t(spp))
         L.scene().warnings.push_back(L.file_of(o.node) + ":" + std::to_string(o.line) + ": " + o.type + " sampler: sample_count " +
@@ -50,10 +54,7 @@ void make_multijitter(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler
 void make_ldsampler(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::LdSampler); }
 void make_sobol(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Sobol); }
 void make_zsobol(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::ZSobol); }
-// Mitsuba's orthogonal-array sampler (Jarosz et al. 2019) is not implemented: refused by name.
-void make_orthogonal(XmlLoader& L, Object& o, RenderSettings&) {
-    throw L.error(o.node, "sampler 'orthogonal' is not supported by candela (use multijitter, ldsampler or sobol)");
-}
+void make_orthogonal(XmlLoader& L, Object& o, RenderSettings& s) { read_sampler(L, o, s, SamplerType::Orthogonal); }
 
 }  // namespace
 
