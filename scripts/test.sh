@@ -10,10 +10,10 @@
 #               Debug run is for assertions and code that -O3 could hide. CANDELA_DEBUG_EXCLUDE=REGEX
 #               replaces the regex (an empty value runs everything). See docs/reliability.md.
 #   --sanitize  the ASan+UBSan build in build-asan/ (MPI off: Open MPI's own leaks are not ours),
-#               every test but the 17 longest statistical and brute-force ones (5-40 s each in
-#               Release, 5-7x that instrumented): each repeats, with more samples, code that a
-#               lighter test of the same family runs instrumented (list and reasons in
-#               docs/reliability.md). CANDELA_ASAN_EXCLUDE=REGEX replaces the list (an empty
+#               every test but the 16 longest statistical and brute-force ones (10-40 s each in
+#               Release, 5-7x that instrumented), each repeating with more samples code that a
+#               lighter test of the same family runs instrumented, and the 14 power controls
+#               (list and reasons in docs/reliability.md). CANDELA_ASAN_EXCLUDE=REGEX replaces the list (an empty
 #               value runs everything).
 #   --tsan      a ThreadSanitizer build in build-tsan/, the render session and the viewer's use of it
 #               without a window (Session.*, ViewerFrontEnd.*, SceneSplit.*), with
@@ -49,7 +49,10 @@ case "$mode" in
     # errors and UB are still fatal).
     viewer='^ViewerWindow\.'
     long='^(Mis\.|BsdfChi2\.SamplingMatchesPdf$|PrincipledChi2\.SamplingMatchesPdf$|KdTree\.(DragonMatchesBruteForce|BunnyMatchesBruteForce|CoherentOriginsMatchBruteForce)$|Filters\.EachFilterMatchesMitsuba$|BsdfWeights\.RoughPlasticWeightIsBounded$|PrincipledMitsuba\.AlbedoAgrees$|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)$|Furnace\.EverySampler$|ImageCornell\.EverySamplerMatchesMitsubaReference$|Cameras\.(Perspective|Orthographic)MatchesMitsubaReference$)'
-    exclude=${CANDELA_ASAN_EXCLUDE-$long}
+    # The power controls (the same agreement render with a deliberately wrong parameter, which
+    # must fail) prove a statistic's power, not memory safety: they run in Release only.
+    controls='^(AnalyticShapes\.MitsubaAgreementDetects|BsdfMitsuba\.[A-Za-z]*Detects|BsdfScenes\.LosslessFurnaceRejects|BsdfWrappers\.MitsubaAgreementDetects|Filters\.BoxImageIsRejected|Furnace\.DetectsBias|ImageCornell\.[A-Za-z]*Detects|Instancing\.MitsubaAgreementDetects|MeshFormatsRender\.ControlsFail|PrincipledMitsuba\.RenderAgreementDetects|Stability\.ScaleComparisonDetects|Texture\.MitsubaAgreementDetects)'
+    exclude=${CANDELA_ASAN_EXCLUDE-$long|$controls}
     ctest --output-on-failure -j"$(nproc)" --timeout 1800 -E "${exclude:+$exclude|}$viewer"
     ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --output-on-failure --timeout 1800 -R "$viewer"
     ;;
