@@ -9,7 +9,8 @@
 //    glass short block (delta lobes) at max depth 1.
 //  * Bdpt.Furnace: the closed diffuse sphere lit by its own emission: Le (1 - a^(d+1)) / (1 - a).
 //  * Bdpt.UnweightedStrategiesAgree: for paths of 2 scattering events on the Cornell box, each
-//    strategy's unweighted image (all four can make every such path there) has the same mean.
+//    strategy's unweighted image (all four can make every such path there) has the same mean
+//    (within 2-4% noise: a 15% brighter control is rejected).
 //  * Bdpt.SameFilmAtAnyThreadCountAndPassSplit; Bdpt.StrategyImagesSumToTheImage; XML and CLI.
 #include <gtest/gtest.h>
 #include <cstring>
@@ -257,7 +258,7 @@ TEST(Bdpt, UnweightedStrategiesAgree) {
         p.settings.max_depth = len;
         p.settings.seed = 900 + uint64_t(b);
         auto sc = base->with_params(p);
-        std::vector<StrategyImage> img = render_bdpt_strategies(*sc, 12, 12, 16, 2, len);
+        std::vector<StrategyImage> img = render_bdpt_strategies(*sc, 12, 12, 64, 2, len);
         for (const StrategyImage& im : img) {
             if (im.s + im.t - 2 != len) continue;
             for (int c = 0; c < 3; ++c) {
@@ -281,10 +282,16 @@ TEST(Bdpt, UnweightedStrategiesAgree) {
             const RunningStats& r = st[size_t(s)][size_t(c)];
             const double z = (r.mean() - m_other) / std::sqrt(sqr(r.std_error()) + v_other);
             const double p = std::erfc(std::abs(z) / std::sqrt(2.0));
-            const double z_ctl = (1.03 * r.mean() - m_other) / std::sqrt(sqr(1.03 * r.std_error()) + v_other);
-            std::printf("  (s %d, t %d) channel %d: mean %.5f others %.5f z %+.2f p %.3g; 3%% brighter z %+.2f\n", s,
-                        len + 2 - s, c, r.mean(), m_other, z, p, z_ctl);
+            // Unweighted strategies are heavy-tailed (the s = t = 2 connection's 1 / dist^2): the
+            // whole-image mean of one is 2-4% noisy here, so the control is 15% brighter.
+            const double z_ctl = (1.15 * r.mean() - m_other) / std::sqrt(sqr(1.15 * r.std_error()) + v_other);
+            const double p_ctl = std::erfc(std::abs(z_ctl) / std::sqrt(2.0));
+            std::printf("  (s %d, t %d) channel %d: mean %.5f others %.5f z %+.2f p %.3g; 15%% brighter p %.3g\n", s,
+                        len + 2 - s, c, r.mean(), m_other, z, p, p_ctl);
             EXPECT_GE(p, level) << "strategy s = " << s << " channel " << c;
+            if (s == 1 && c == 0) {
+                EXPECT_LT(p_ctl, level) << "the 15% brighter control is not rejected";
+            }
         }
 }
 
