@@ -31,7 +31,7 @@ case "$mode" in
   --debug)
     dir=$(bash scripts/build.sh --debug | tail -n 1)
     cd "$dir"
-    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)|Bdpt\.(Furnace|AgreesWithPathOnThe[A-Za-z]*|UnweightedStrategiesAgree))\.?'
+    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)|Bdpt\.(Furnace|AgreesWithPath[A-Za-z]*|UnweightedStrategiesAgree))\.?'
     exclude=${CANDELA_DEBUG_EXCLUDE-$heavy}
     ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
     ;;

@@ -7,6 +7,7 @@
 //    tracer, independent seeds, block z-test and whole-image z-test, Sidak-corrected, with the 3%
 //    brighter control rejected; Bdpt.AgreesWithPathOnTheSpecularBox: a mirror tall block and a
 //    glass short block (delta lobes) at max depth 1.
+//  * Bdpt.AgreesWithPathUnderOtherLights: constant, point and directional lights, max depth 3.
 //  * Bdpt.Furnace: the closed diffuse sphere lit by its own emission: Le (1 - a^(d+1)) / (1 - a).
 //  * Bdpt.UnweightedStrategiesAgree: for paths of 2 scattering events on the Cornell box, each
 //    strategy's unweighted image (all four can make every such path there) has the same mean
@@ -362,4 +363,19 @@ TEST(Bdpt, XmlAndCommandLine) {
     Image u = read_linear_image(d + "/st/bdpt_s2_t1_unweighted.exr");
     EXPECT_EQ(w.rgb.size(), im.rgb.size());
     EXPECT_EQ(u.rgb.size(), im.rgb.size());
+}
+
+// The other lights (tests/data/scenes/emitter_*.xml: a few objects on a plane): an infinite light
+// (constant: s = 0 on escaped camera paths, light paths from the bounding disk), a delta position
+// (point) and a delta direction (directional), max depth 3.
+TEST(Bdpt, AgreesWithPathUnderOtherLights) {
+    const std::vector<std::string> names = {"constant", "point", "directional"};
+    for (const std::string& name : names) {
+        auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/emitter_" + name + ".xml",
+                                         {{"res", "16"}, {"max_depth", "4"}}));
+        SceneParams p = sc->params();
+        ImageEstimate bd = batches(*sc, p, IntegratorType::Bdpt, 8, 16, 700);
+        ImageEstimate pt = batches(*sc, p, IntegratorType::Path, 8, 36, 800);
+        compare(bd, pt, name + " depth 3", int(names.size()));
+    }
 }
