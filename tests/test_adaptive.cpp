@@ -149,7 +149,10 @@ TEST(Adaptive, CliRefusesWhatItDoesNotSupport) {
     EXPECT_NE(r.output.find("needs the independent sampler"), std::string::npos) << r.output;
     r = test::run_candela(base + "--integrator ptracer");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("light tracer's splats land anywhere"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("splats of ptracer and bdpt land anywhere"), std::string::npos) << r.output;
+    r = test::run_candela(base + "--integrator bdpt");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("splats of ptracer and bdpt land anywhere"), std::string::npos) << r.output;
     r = test::run_candela(base + "--checkpoint " + d + "/c.ckpt");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("do not checkpoint"), std::string::npos) << r.output;

@@ -363,7 +363,7 @@ TEST(IntegratorXml, ParametersAndErrors) {
             EXPECT_NE(std::string(e.what()).find("scene.xml:"), std::string::npos) << e.what();
         }
     };
-    expect_error("<integrator type=\"bdpt\"/>", "unsupported integrator type 'bdpt'");
+    expect_error("<integrator type=\"sppm\"/>", "unsupported integrator type 'sppm'");
     expect_error("<integrator type=\"direct\"><integer name=\"shading_samples\" value=\"2\"/><integer name=\"bsdf_samples\" value=\"1\"/></integrator>",
                  "cannot give both");
     expect_error("<integrator type=\"direct\"><integer name=\"emitter_samples\" value=\"0\"/><integer name=\"bsdf_samples\" value=\"0\"/></integrator>",

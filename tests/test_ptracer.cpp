@@ -231,7 +231,7 @@ TEST(Ptracer, CheckpointAndResumeKeepTheSplats) {
     EXPECT_EQ(c.exit_code, 1) << c.output;
     EXPECT_NE(c.output.find("another scene or other settings"), std::string::npos) << c.output;
     // An unknown integrator is a one-line usage error.
-    RunResult e = run_candela("--integrator bdpt --out " + d + "/y.exr");
+    RunResult e = run_candela("--integrator nope --out " + d + "/y.exr");
     EXPECT_NE(e.exit_code, 0);
     EXPECT_NE(e.output.find("--integrator"), std::string::npos) << e.output;
 }

@@ -412,7 +412,7 @@ TEST(SceneXml, Errors) {
     expect_error("<bsdf type=\"normalmap\" id=\"n\">\n<bsdf type=\"diffuse\"/></bsdf>\n", 2, "needs a texture named 'normalmap'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"measured\"/></shape>\n", 3, "unsupported bsdf type 'measured'");
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "needs a nested <bsdf>");
-    expect_error("<integrator type=\"bdpt\"/>\n", 2, "unsupported integrator type 'bdpt'");
+    expect_error("<integrator type=\"sppm\"/>\n", 2, "unsupported integrator type 'sppm'");
     expect_error("<emitter type=\"sunsky\"/>\n", 2, "unsupported emitter type 'sunsky'");  // constant is supported now
     expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\">\n<rfilter type=\"mitchell\"/></film></sensor>\n", 4,
                  "unsupported rfilter type 'mitchell'");

@@ -19,6 +19,8 @@
 #include "film/exr_layers.h"
 #include "film/film.h"
 #include "film/image_io.h"
+#include "integrator/bdpt/bdpt.h"
+#include "film/image_io.h"
 #include "headless/headless.h"
 #include "render/renderer.h"
 
@@ -148,6 +150,33 @@ void print_memory_summary(const Scene& scene) {
                  double(mem.accel) * per_tri, double(mem.lights) * per_tri);
 }
 
+namespace {
+
+// pbrt's visualizestrategies: bdpt_s<S>_t<T>_{weighted,unweighted}.exr for every path length up to
+// max_depth (5 when unbounded), over as many samples per pixel as the render took.
+void write_bdpt_strategies(const HeadlessOptions& opt, const Scene& scene, const Film& film, int threads) {
+    std::filesystem::create_directories(opt.bdpt_strategies);
+    const uint32_t spp = film.sample_count(0, 0);
+    const int max_length = scene.settings.max_depth >= 0 ? scene.settings.max_depth : 5;
+    const std::vector<StrategyImage> imgs =
+        render_bdpt_strategies(scene, film.width(), film.height(), int(std::max(1u, spp)), threads, max_length);
+    for (const StrategyImage& s : imgs) {
+        Image im;
+        im.width = film.width();
+        im.height = film.height();
+        const std::string base = opt.bdpt_strategies + "/bdpt_s" + std::to_string(s.s) + "_t" + std::to_string(s.t);
+        im.rgb = s.weighted;
+        write_linear_image(base + "_weighted.exr", im);
+        im.rgb = s.unweighted;
+        write_linear_image(base + "_unweighted.exr", im);
+    }
+    if (!opt.quiet)
+        std::fprintf(stderr, "candela: %zu BDPT strategy images (weighted and unweighted) -> %s\n", imgs.size() * 2,
+                     opt.bdpt_strategies.c_str());
+}
+
+}  // namespace
+
 int run_headless(const HeadlessOptions& opt) {
     std::string ext = file_extension(opt.out);
     if (ext != ".png" && ext != ".exr" && ext != ".pfm")
@@ -204,8 +233,8 @@ int run_headless(const HeadlessOptions& opt) {
         if (st.sampler.type != SamplerType::Independent)
             throw Error(src, 0, std::string("--target-error needs the independent sampler (the halves must be "
                                             "independent), not ") + sampler_type_name(st.sampler.type));
-        if (st.integrator.type == IntegratorType::Ptracer)
-            throw Error(src, 0, "--target-error needs camera paths per pixel; the light tracer's splats land anywhere");
+        if (st.integrator.type == IntegratorType::Ptracer || st.integrator.type == IntegratorType::Bdpt)
+            throw Error(src, 0, "--target-error needs camera paths per pixel; the splats of ptracer and bdpt land anywhere");
         if (film.weighted()) throw Error(src, 0, "--target-error needs the box reconstruction filter");
         if (!aovs.empty()) throw Error(src, 0, "--target-error does not render the aov integrator's layers");
         if (st.alpha) throw Error(src, 0, "--target-error does not render an alpha channel (rgba film)");
@@ -314,6 +343,7 @@ int run_headless(const HeadlessOptions& opt) {
     if (checkpointing && whole_passes) save("final");
 
     const WrittenImage wi = write_headless_image(opt, scene, film);
+    if (!opt.bdpt_strategies.empty() && !g_signal.load()) write_bdpt_strategies(opt, scene, film, threads);
     const std::string& written = wi.path;
     const bool png_failed = wi.png_failed;
 

@@ -26,6 +26,9 @@ struct HeadlessOptions {
     // is below target_error (after adaptive_min_spp samples), and the render when all have stopped.
     double target_error = 0;
     int adaptive_min_spp = 16;
+    // --bdpt-strategies DIR: after the render, one EXR per BDPT strategy (s, t), weighted and
+    // unweighted, over the same samples per pixel (integrator/bdpt/bdpt.h render_bdpt_strategies).
+    std::string bdpt_strategies;
 };
 
 // Renders the passes, shows progress (a bar on a terminal, a summary line otherwise), and writes

@@ -54,10 +54,11 @@ int main(int argc, char** argv) {
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
     std::string integrator;
     auto* i_opt = app.add_option("--integrator", integrator,
-                                 "Integrator: path (the path tracer), direct (direct lighting) or ptracer (light\n"
-                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer); replaces the\n"
-                                 "scene's <integrator> type, keeping its depths and hide_emitters")
-                      ->check(CLI::IsMember({"path", "direct", "ptracer"}));
+                                 "Integrator: path (the path tracer), direct (direct lighting), ptracer (light\n"
+                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer) or bdpt\n"
+                                 "(bidirectional path tracing, every (s, t) strategy, MIS); replaces the scene's\n"
+                                 "<integrator> type, keeping its depths and hide_emitters")
+                      ->check(CLI::IsMember({"path", "direct", "ptracer", "bdpt"}));
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
                                        "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"
@@ -69,6 +70,9 @@ int main(int argc, char** argv) {
                           ->check(CLI::Range(1, 1 << 24));
     app.add_option("--accel", ov.accel, "Ray accelerator: auto, kdtree, hybrid, brute (embree when built with it)");
     app.add_flag("--quiet,-q", opt.quiet, "No progress or summary output");
+    app.add_option("--bdpt-strategies", opt.bdpt_strategies,
+                   "After a headless render, write one EXR per BDPT strategy (s, t) into this directory,\n"
+                   "weighted and unweighted (pbrt's visualizestrategies), path lengths up to max depth");
     auto* ck_opt = app.add_option("--checkpoint", opt.checkpoint,
                                   "Headless: save the render's state to FILE (atomically) periodically, at the end and "
                                   "when stopped by a signal")

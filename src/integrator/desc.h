@@ -11,6 +11,7 @@ enum class IntegratorType {
     Path,    // path (and volpath in a scene without media): integrator/path/
     Direct,  // direct: integrator/direct/
     Ptracer, // ptracer (light tracing, splats only): integrator/ptracer/
+    Bdpt,    // bdpt (bidirectional path tracing, camera samples and splats): integrator/bdpt/
 };
 
 // Arbitrary output variables of Mitsuba's `aov` wrapper: values of the first surface the camera

@@ -1,4 +1,5 @@
 #include "integrator/integrator.h"
+#include "integrator/bdpt/bdpt.h"
 #include "integrator/direct/direct.h"
 #include "integrator/path/path_pass.h"
 #include "integrator/ptracer/ptracer.h"
@@ -9,6 +10,7 @@ std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
     switch (scene.settings.integrator.type) {
         case IntegratorType::Direct: return std::make_unique<DirectPass>();
         case IntegratorType::Ptracer: return std::make_unique<LightTracerPass>();
+        case IntegratorType::Bdpt: return std::make_unique<BdptPass>();
         case IntegratorType::Path: break;
     }
     return std::make_unique<PathPass>();

@@ -40,6 +40,12 @@ struct ShadingT {
             if (is_wrapped) return wrapped.pdf_w(wo, wi, mode);
         return pdf_in<DiffuseOnly>(*bsdf, wo, wi, mode);
     }
+    // The density with another wo (BDPT's reverse pdfs: the path walked the other way).
+    float pdf_from(vec3 wo_other, vec3 wi, TransportMode mode) const {
+        if constexpr (!DiffuseOnly)
+            if (is_wrapped) return wrapped.pdf_w(wo_other, wi, mode);
+        return pdf_in<DiffuseOnly>(*bsdf, wo_other, wi, mode);
+    }
     std::optional<BsdfSample> sample(float u1, vec2 u2, TransportMode mode = TransportMode::Radiance) const {
         if constexpr (!DiffuseOnly)
             if (is_wrapped) return wrapped.sample_w(wo, u1, u2, mode);

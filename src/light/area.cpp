@@ -134,12 +134,14 @@ bool LightSet::sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const 
         if (k == 0) {
             if (!sample_area_li(ref_p, u1r, u2, out)) return false;
             out.pdf *= choice_pmf_;
+            out.light = -1;
             return true;
         }
         --k;
     }
     if (!candela::sample_li(lights_[k].model, sphere_, ref_p, u2, out)) return false;
     out.pdf *= choice_pmf_;
+    out.light = int32_t(k);
     return !is_black(out.Le) && out.pdf > 0.f;
 }
 
@@ -290,7 +292,8 @@ bool LightSet::sample_position(float u_sel, vec2 u_pos, PositionSample& out) con
     return true;
 }
 
-std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const {
+std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 u_dir, SurfaceInteraction* on_light,
+                                                 int32_t* light) const {
     if (choices_ == 0) return std::nullopt;
     const float x = u_sel * float(choices_);
     const uint32_t k = std::min(uint32_t(x), choices_ - 1);
@@ -298,6 +301,7 @@ std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 
         const uint32_t j = has_area() ? k - 1 : k;
         std::optional<EmissionSample> es = candela::sample_le(lights_[j].model, sphere_, u_pos, u_dir);
         if (es) es->pdf_pos *= choice_pmf_;
+        if (light) *light = int32_t(j);
         return es;
     }
     PositionSample ps;
@@ -314,6 +318,8 @@ std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 
     es.n = ps.si.ns;
     es.pdf_pos = ps.pdf;
     es.pdf_dir = square_to_cosine_hemisphere_pdf(local);
+    if (on_light) *on_light = ps.si;
+    if (light) *light = -1;
     return es;
 }
 

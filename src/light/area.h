@@ -68,7 +68,10 @@ public:
     // sample_li does, and pdf_pos includes that pmf. Area lights: a point uniform by area on the
     // chosen triangle or shape, a cosine-distributed direction on its emitting side. Returns
     // nothing when the scene has no light or the chosen one emits nothing there.
-    std::optional<EmissionSample> sample_le(float u_sel, vec2 u_pos, vec2 u_dir) const;
+    // `on_light` (area lights) receives the point's interaction, `light` the index into light(i)
+    // (-1: an area light), when given.
+    std::optional<EmissionSample> sample_le(float u_sel, vec2 u_pos, vec2 u_dir, SurfaceInteraction* on_light = nullptr,
+                                            int32_t* light = nullptr) const;
     // A point on a light for a connection to the camera (the light tracer's emitters seen
     // directly): u_sel picks the light as sample_le does. Area lights: a point uniform by area on
     // the chosen triangle or shape, `pdf` its area density times the pmf, `Le` the radiance it

@@ -54,6 +54,7 @@ struct LightSample {
     float pdf = 0.f;            // see "pdf" above; includes the pmf of the light's choice
     bool delta = false;         // a delta light: no MIS with BSDF sampling (it cannot be hit)
     bool infinite = false;      // the shadow ray is unbounded
+    int32_t light = -1;         // LightSet::sample_li: index into light(i), -1 for an area light
 };
 
 // A ray leaving a light (see "sample_le" above).

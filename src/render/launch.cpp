@@ -26,6 +26,8 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
         st.integrator.type = *ov.integrator;
         if (*ov.integrator == IntegratorType::Ptracer && !st.integrator.aovs.empty())
             throw Error("--integrator ptracer: the scene's aov or moment integrator needs camera rays, which ptracer has none of");
+        if (*ov.integrator == IntegratorType::Bdpt && !st.integrator.aovs.empty())
+            throw Error("--integrator bdpt: the scene's aov or moment integrator is not rendered by bdpt");
     }
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
@@ -43,13 +45,15 @@ IntegratorType parse_integrator_type(const std::string& s) {
     if (s == "path") return IntegratorType::Path;
     if (s == "direct") return IntegratorType::Direct;
     if (s == "ptracer") return IntegratorType::Ptracer;
-    throw Error("unknown integrator '" + s + "' (expected path, direct or ptracer)");
+    if (s == "bdpt") return IntegratorType::Bdpt;
+    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer or bdpt)");
 }
 
 const char* integrator_type_name(IntegratorType t) {
     switch (t) {
         case IntegratorType::Direct: return "direct";
         case IntegratorType::Ptracer: return "ptracer";
+        case IntegratorType::Bdpt: return "bdpt";
         default: return "path";
     }
 }

@@ -104,16 +104,22 @@ void Viewer::panel() {
         // Switches the running render: the next pass makes the new integrator (render_pass).
         // The aov and moment wrappers need camera rays: ptracer is offered without them only.
         const bool wrapped = !st.integrator.aovs.empty();
-        static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer};
-        int type = st.integrator.type == IntegratorType::Direct ? 1 : st.integrator.type == IntegratorType::Ptracer ? 2 : 0;
-        if (ImGui::Combo("integrator", &type, wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0")) {
+        static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer,
+                                                IntegratorType::Bdpt};
+        int type = st.integrator.type == IntegratorType::Direct    ? 1
+                   : st.integrator.type == IntegratorType::Ptracer ? 2
+                   : st.integrator.type == IntegratorType::Bdpt    ? 3
+                                                                   : 0;
+        if (ImGui::Combo("integrator", &type,
+                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0")) {
             st.integrator.type = kTypes[type];
             fe_->params_changed(viewer_now());
         }
         if (ImGui::IsItemHovered())
             ImGui::SetTooltip("path: path tracing with next-event estimation and MIS\n"
                               "direct: direct lighting only (Mitsuba's direct)\n"
-                              "ptracer: light tracing, every light-path vertex splatted through the camera");
+                              "ptracer: light tracing, every light-path vertex splatted through the camera\n"
+                              "bdpt: bidirectional path tracing, every (s, t) strategy weighted by MIS");
         int mode = int(st.sampling);
         if (ImGui::Combo("sampling", &mode, "light sampling\0BSDF sampling\0MIS\0")) {
             st.sampling = SamplingMode(mode);

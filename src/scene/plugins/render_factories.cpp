@@ -97,6 +97,15 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         p.report_unused();
         return IntegratorRole::Renders;
     }
+    if (type == "bdpt") {
+        // Bidirectional path tracing (integrator/bdpt/), Mitsuba 0.6's bdpt with Mitsuba 3's
+        // depth and hide_emitters meanings.
+        read_depths(p, st);
+        d.type = IntegratorType::Bdpt;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
     if (type == "moment") {
         // The image is the nested integrator's; the caller, which knows the nested integrator's
         // name, adds the moment channels (AovType::Moment) once the nesting is read.
@@ -110,7 +119,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, ptracer, moment, aov)");
+                "' (candela supports: path, volpath, direct, ptracer, bdpt, moment, aov)");
 }
 
 FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {

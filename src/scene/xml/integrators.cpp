@@ -16,6 +16,8 @@ void load_integrator(XmlLoader& L, pugi::xml_node n) {
             // The light tracer's image is all splats: there is no camera ray to take AOVs or moments of.
             if (s.integrator.type == IntegratorType::Ptracer && (level > 0 || !moment.empty()))
                 throw L.error(n, "ptracer cannot be nested in an aov or moment integrator (it traces no camera rays)");
+            if (s.integrator.type == IntegratorType::Bdpt && (level > 0 || !moment.empty()))
+                throw L.error(n, "bdpt cannot be nested in an aov or moment integrator (not supported)");
             L.finish(o);
             break;
         }
