@@ -11,29 +11,17 @@ included). RMSE = sqrt(MSE - MSE_ref) over pixels and channels, MSE_ref = c / re
 c = the mean of MSE x spp over the plain renders (the reference is a plain render at ref_spp).
 The time (and the mean spp) to reach an RMSE is interpolated log-log along each curve. Prints Markdown tables.
 """
-import argparse, os, re, subprocess, sys
+import argparse, os, sys
 import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchlib import SCENES, read_pfm, run_candela  # noqa: E402
 
-SCENES = {"cornell": [], "veach-mis": ["scenes/veach-mis/scene.xml"], "caustics": ["scenes/caustics/scene.xml"]}
-
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    return data.reshape(h, w, 3 if kind == b"PF" else 1).astype(np.float64)
 
 
 def render(args, scene, out, extra):
     cmd = [args.candela, *SCENES[scene], "--width", str(args.res), "--height", str(args.res), "--threads",
            str(args.threads), "--sampler", "independent", "--out", out, *extra]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    m = re.search(r"([0-9.e+]+) spp in ([0-9.]+) s", r.stderr)
-    if r.returncode != 0 or not m:
-        sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
-    return float(m.group(1)), float(m.group(2))
+    return run_candela(cmd)
 
 
 def time_at(curve, rmse):

@@ -20,32 +20,20 @@ instructions per sample counted by callgrind (32 x 32, 1 thread, Ir(12 spp) - Ir
 start-up cancels), deterministic where wall times on a shared machine vary by +-30%; --cost wall
 uses candela's own render time (its summary line, the fastest over the seeds) instead. Prints a Markdown table (docs/samplers.md has one). Needs numpy only.
 """
-import argparse, os, re, subprocess, sys, time
+import argparse, os, re, subprocess, sys
 import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchlib import SCENES, read_pfm, run_candela  # noqa: E402
 
-SAMPLERS = ["independent", "stratified", "multijitter", "ldsampler", "sobol", "zsobol"]
-SCENES = {"cornell": [], "veach-mis": ["scenes/veach-mis/scene.xml"], "caustics": ["scenes/caustics/scene.xml"]}
+SAMPLERS = ["independent", "stratified", "multijitter", "ldsampler", "orthogonal", "sobol", "zsobol"]
 
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    c = 3 if kind == b"PF" else 1
-    return data.reshape(h, w, c).astype(np.float64)
 
 
 def render(args, scene, out, sampler, seed, spp, sample_count):
     cmd = [args.candela, *SCENES[scene], "--width", str(args.res), "--height", str(args.res), "--threads",
            str(args.threads), "--sampler", sampler, "--seed", str(seed), "--out", out,
            "--sample-count", str(sample_count), "--spp-per-frame", str(spp), "--frames", "1"]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    m = re.search(r"spp in ([0-9.]+) s", r.stderr)
-    if r.returncode != 0 or not m:
-        sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
-    return float(m.group(1))  # the render's own time (candela's summary), without start-up and loading
+    return run_candela(cmd)[1]
 
 
 def instructions(args, scene, sampler, spp):

@@ -25,23 +25,16 @@ complete set of N in candela (sample_count = N); Mitsuba renders in passes of 64
 bound on llvm memory; 49 for orthogonal), each pass its own complete set, as its renders would.
 Wall times on a shared machine vary by +-30%: read the time columns with that in mind.
 """
-import argparse, json, math, os, re, subprocess, sys
+import argparse, json, math, os, re, sys
 import numpy as np
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchlib import read_pfm, run_candela  # noqa: E402
 
 TOOLS = "/work/shared/tools"
 SCENE = "scenes/cornell-box/scene.xml"
 CANDELA = ["independent", "sobol", "zsobol", "orthogonal"]
 MITSUBA = ["independent", "stratified", "multijitter", "ldsampler", "orthogonal"]
 
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    c = 3 if kind == b"PF" else 1
-    return data.reshape(h, w, c)[::-1].astype(np.float64)  # PFM rows run bottom to top
 
 
 def next_square_prime(n):
@@ -63,11 +56,7 @@ def candela_render(args, sampler, seed, spp, out):
     cmd = [args.candela, SCENE, "--width", str(args.res), "--height", str(args.res), "--threads", str(args.threads),
            "--sampler", sampler, "--seed", str(seed), "--sample-count", str(spp), "--spp-per-frame", str(spp),
            "--frames", "1", "--out", out]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    m = re.search(r"spp in ([0-9.]+) s", r.stderr)
-    if r.returncode != 0 or not m:
-        sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
-    return read_pfm(out), float(m.group(1))
+    return read_pfm(out), run_candela(cmd)[1]
 
 
 def mitsuba_scene(args, sampler):
