@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Time to a given error, candela's samplers against Mitsuba 3's, in one sitting.
 
-  nice -n 5 $PY bench/samplers/time_to_error.py [--res 128] [--ref-spp 16384] [--threads 2]
+  nice -n 5 $PY bench/samplers/time_to_error.py [--scene cornell] [--res 128] [--ref-spp 16384] [--threads 2]
         [--seeds 2] [--levels 64,256,1024] [--target 0] [--candela build/bin/candela]
 
 $PY is the reference venv's python (/root/.cache/candela-ref/venv/bin/python): Mitsuba 3 renders
 in this process through /work/shared/tools/mitsuba_render.py (llvm_ad_rgb, warm-up pass untimed,
 so JIT compilation is not counted), candela as a subprocess (its summary line's render time, no
-start-up or loading). Scene: scenes/cornell-box/scene.xml at --res, unbounded depth, box filter;
+start-up or loading). Scene (--scene): cornell, veach-mis or caustics (scenes/*/scene.xml) at
+width --res (height by the scene's aspect), unbounded depth, box filter;
 Mitsuba's sampler is switched by a copy of the XML whose <sampler> type is the one measured.
 
 Reference: Mitsuba llvm_ad_rgb, independent sampler, --ref-spp, seed 1000 (cached in --cache).
@@ -31,7 +32,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from benchlib import read_pfm, run_candela  # noqa: E402
 
 TOOLS = "/work/shared/tools"
-SCENE = "scenes/cornell-box/scene.xml"
+# name -> (XML, height / width): the XMLs take $width and $height (the Cornell box's $res sets both).
+XMLS = {"cornell": ("scenes/cornell-box/scene.xml", 1.0), "veach-mis": ("scenes/veach-mis/scene.xml", 2 / 3),
+        "caustics": ("scenes/caustics/scene.xml", 0.75)}
 CANDELA = ["independent", "sobol", "zsobol", "orthogonal"]
 MITSUBA = ["independent", "stratified", "multijitter", "ldsampler", "orthogonal"]
 
@@ -53,19 +56,25 @@ def level(renderer, sampler, n):
 
 
 def candela_render(args, sampler, seed, spp, out):
-    cmd = [args.candela, SCENE, "--width", str(args.res), "--height", str(args.res), "--threads", str(args.threads),
+    cmd = [args.candela, XMLS[args.scene][0], "--width", str(args.res), "--height", str(height(args)), "--threads", str(args.threads),
            "--sampler", sampler, "--seed", str(seed), "--sample-count", str(spp), "--spp-per-frame", str(spp),
            "--frames", "1", "--out", out]
-    return read_pfm(out), run_candela(cmd)[1]
+    t = run_candela(cmd)[1]
+    return read_pfm(out), t
+
+
+def height(args):
+    return max(1, round(args.res * XMLS[args.scene][1]))
 
 
 def mitsuba_scene(args, sampler):
-    """A copy of the Cornell XML with the sampler's type switched, its mesh paths made absolute."""
-    src = open(SCENE).read()
-    base = os.path.dirname(os.path.abspath(SCENE))
+    """A copy of the scene's XML with the sampler's type switched, its mesh paths made absolute."""
+    xml = XMLS[args.scene][0]
+    src = open(xml).read()
+    base = os.path.dirname(os.path.abspath(xml))
     src = re.sub(r'value="([^"/]+\.obj)"', lambda m: f'value="{base}/{m.group(1)}"', src)
     src = src.replace('<sampler type="independent">', f'<sampler type="{sampler}">')
-    path = os.path.join(args.cache, f"cornell_{sampler}.xml")
+    path = os.path.join(args.cache, f"{args.scene}_{sampler}.xml")
     with open(path, "w") as f:
         f.write(src)
     return path
@@ -75,7 +84,8 @@ def mitsuba_render(args, sampler, seed, spp):
     import mitsuba_render as mr
     per_pass = 49 if sampler == "orthogonal" else min(64, spp)
     img, info = mr.render(mitsuba_scene(args, sampler), variant="llvm_ad_rgb", spp=spp, seed=seed, threads=args.threads,
-                          spp_per_pass=per_pass, defines={"res": str(args.res)}, quiet=True, warmup=True)
+                          spp_per_pass=per_pass,
+                          defines={"width": str(args.res), "height": str(height(args))}, quiet=True, warmup=True)
     return np.asarray(img, dtype=np.float64)[..., :3], float(info["render_s"])
 
 
@@ -111,7 +121,8 @@ def spp_for(pts, e):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--candela", default="build/bin/candela")
-    ap.add_argument("--res", type=int, default=128)
+    ap.add_argument("--scene", choices=sorted(XMLS), default="cornell")
+    ap.add_argument("--res", type=int, default=128, help="image width (the height follows the scene's aspect)")
     ap.add_argument("--ref-spp", type=int, default=16384)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seeds", type=int, default=2)
@@ -119,12 +130,13 @@ def main():
     ap.add_argument("--target", type=float, default=0, help="RMSE to reach (0: candela independent's at the last level)")
     ap.add_argument("--candela-samplers", default=",".join(CANDELA))
     ap.add_argument("--mitsuba-samplers", default=",".join(MITSUBA))
-    ap.add_argument("--cache", default="/tmp/candela-tte-bench")
+    ap.add_argument("--cache", default="")
     ap.add_argument("--table-only", action="store_true")
     ap.add_argument("--retime", type=int, default=0, metavar="R",
                     help="R more timing rounds over the last run's rows (interleaved), then the table")
     args = ap.parse_args()
     args.levels = [int(x) for x in args.levels.split(",")]
+    args.cache = args.cache or f"/tmp/candela-tte-bench/{args.scene}"
     os.makedirs(args.cache, exist_ok=True)
     if args.table_only or args.retime:
         d = json.load(open(f"{args.cache}/rows.json"))
@@ -136,7 +148,7 @@ def main():
         print_table(args, d["rows"], d["ref_rmse"] ** 2)
         return
     sys.path.insert(0, TOOLS)
-    ref_path = f"{args.cache}/ref_{args.res}_{args.ref_spp}.npy"
+    ref_path = f"{args.cache}/ref_{args.scene}_{args.res}_{args.ref_spp}.npy"
     if not os.path.exists(ref_path):
         print(f"reference: Mitsuba independent, {args.ref_spp} spp ...", file=sys.stderr, flush=True)
         ref, _ = mitsuba_render(args, "independent", 1000, args.ref_spp)
@@ -171,13 +183,13 @@ def retime(args, rows):
         else:
             _, t = mitsuba_render(args, sampler, 99, n)
         row[3] = min(row[3], t / n)
-        print(f"  time {renderer} {sampler}: {args.res * args.res * n / t * 1e-6:.2f} Msamples/s", file=sys.stderr, flush=True)
+        print(f"  time {renderer} {sampler}: {args.res * height(args) * n / t * 1e-6:.2f} Msamples/s", file=sys.stderr, flush=True)
 
 
 def print_table(args, rows, ref_mse):
     target = args.target or dict(((r, s), p) for r, s, p, _ in rows)[("candela", "independent")][-1][1]
     base = None
-    print(f"Cornell box {args.res}x{args.res}, {args.threads} threads, {args.seeds} seeds per level, reference Mitsuba "
+    print(f"{args.scene} {args.res}x{height(args)}, {args.threads} threads, {args.seeds} seeds per level, reference Mitsuba "
           f"independent {args.ref_spp} spp (its RMSE {math.sqrt(ref_mse):.5f}, taken out); "
           f"target RMSE {target:.5f}\n")
     lv = " | ".join(f"RMSE @{n}" for n in args.levels)
@@ -187,7 +199,7 @@ def print_table(args, rows, ref_mse):
         n = spp_for(pts, target)
         t = n * per_spp
         base = base or t
-        msps = args.res * args.res / per_spp * 1e-6
+        msps = args.res * height(args) / per_spp * 1e-6
         es = " | ".join(f"{e:.5f}" + (f" ({m} spp)" if m != lvl else "") for (m, e), lvl in zip(pts, args.levels))
         print(f"| {renderer} | {s} | {msps:.2f} | {es} | {n:.0f} | {t:.2f} | {base / t:.2f}x |", flush=True)
 
