@@ -122,38 +122,50 @@ protected:
     PCG32 rng_;
 };
 
-// Mitsuba's `stratified`: n' = r^2 strata. 1D: the sample's stratum of n' is a per-dimension
-// random permutation of its index in the set; 2D: the same on an r x r grid. jitter: uniform in
-// the stratum, else its centre (not unbiased for an integrand that varies within a stratum: as
-// Mitsuba, for comparisons only).
-class StratifiedSampler final : public PixelSampleBase {
-public:
-    explicit StratifiedSampler(const SamplerSetup& s)
-        : PixelSampleBase(s.seed), jitter_(s.desc.jitter),
-          n_(sampler_sample_count(SamplerType::Stratified, s.sample_count)) {
-        res_ = 1;
-        while (res_ * res_ < n_) ++res_;
-    }
-    void start_pixel_sample(ivec2 pixel, uint32_t i) {
+// The samplers that draw a pixel's samples in sets of n' (Mitsuba's stratified, multijitter,
+// ldsampler, orthogonal): sample i is member i mod n' of set i / n'; every set is a fresh
+// randomisation. jitter: uniform inside a stratum, else its centre.
+class SetSampleBase : public PixelSampleBase {
+protected:
+    SetSampleBase(uint64_t seed, uint32_t set_size, bool jitter)
+        : PixelSampleBase(seed), n_(set_size), jitter_(jitter) {}
+    void start_set(ivec2 pixel, uint32_t i) {
         start(pixel, i);
         set_ = i / n_;
         member_ = i % n_;
     }
+    // The next dimension's seed in this set.
+    uint32_t next_seed() { return next_dim_seed(set_); }
+    float jit() { return jitter_ ? rng().next_float() : 0.5f; }
+    uint32_t n_, set_ = 0, member_ = 0;
+    bool jitter_;
+};
+
+// Mitsuba's `stratified`: n' = r^2 strata. 1D: the sample's stratum of n' is a per-dimension
+// random permutation of its index in the set; 2D: the same on an r x r grid. jitter: uniform in
+// the stratum, else its centre (not unbiased for an integrand that varies within a stratum: as
+// Mitsuba, for comparisons only).
+class StratifiedSampler final : public SetSampleBase {
+public:
+    explicit StratifiedSampler(const SamplerSetup& s)
+        : SetSampleBase(s.seed, sampler_sample_count(SamplerType::Stratified, s.sample_count), s.desc.jitter) {
+        res_ = 1;
+        while (res_ * res_ < n_) ++res_;
+    }
+    void start_pixel_sample(ivec2 pixel, uint32_t i) { start_set(pixel, i); }
     float next_1d() {
-        const uint32_t p = sampler_detail::permute(member_, n_, next_dim_seed(set_));
+        const uint32_t p = sampler_detail::permute(member_, n_, next_seed());
         return sampler_detail::below_one((float(p) + jit()) / float(n_));
     }
     vec2 next_2d() {
-        const uint32_t p = sampler_detail::permute(member_, n_, next_dim_seed(set_));
+        const uint32_t p = sampler_detail::permute(member_, n_, next_seed());
         const float jx = jit(), jy = jit();
         return vec2(sampler_detail::below_one((float(p % res_) + jx) / float(res_)),
                     sampler_detail::below_one((float(p / res_) + jy) / float(res_)));
     }
 
 private:
-    float jit() { return jitter_ ? rng().next_float() : 0.5f; }
-    bool jitter_;
-    uint32_t n_, res_ = 1, set_ = 0, member_ = 0;
+    uint32_t res_ = 1;
 };
 
 // Mitsuba's `multijitter`: correlated multi-jittered sampling (Kensler 2013), n' = a x b with
@@ -161,26 +173,21 @@ private:
 // permutation of its index; inside the cell it takes sub-column sy(y) of b and sub-row sx(x) of a,
 // with sx, sy random permutations shared by all cells of a column / row, so that both 1D
 // projections fall one point per stratum of n' as well. 1D: as stratified.
-class MultijitterSampler final : public PixelSampleBase {
+class MultijitterSampler final : public SetSampleBase {
 public:
     explicit MultijitterSampler(const SamplerSetup& s)
-        : PixelSampleBase(s.seed), jitter_(s.desc.jitter),
-          n_(sampler_sample_count(SamplerType::Multijitter, s.sample_count)) {
+        : SetSampleBase(s.seed, sampler_sample_count(SamplerType::Multijitter, s.sample_count), s.desc.jitter) {
         a_ = 1;
         while ((a_ + 1) * (a_ + 1) <= n_) ++a_;
         b_ = n_ / a_;
     }
-    void start_pixel_sample(ivec2 pixel, uint32_t i) {
-        start(pixel, i);
-        set_ = i / n_;
-        member_ = i % n_;
-    }
+    void start_pixel_sample(ivec2 pixel, uint32_t i) { start_set(pixel, i); }
     float next_1d() {
-        const uint32_t p = sampler_detail::permute(member_, n_, next_dim_seed(set_));
+        const uint32_t p = sampler_detail::permute(member_, n_, next_seed());
         return sampler_detail::below_one((float(p) + jit()) / float(n_));
     }
     vec2 next_2d() {
-        const uint32_t seed = next_dim_seed(set_);
+        const uint32_t seed = next_seed();
         const uint32_t p = sampler_detail::permute(member_, n_, seed);
         const uint32_t x = p % a_, y = p / a_;
         const uint32_t sx = sampler_detail::permute(x, a_, seed * 0x2c1b3c6du + 1u);
@@ -191,38 +198,29 @@ public:
     }
 
 private:
-    float jit() { return jitter_ ? rng().next_float() : 0.5f; }
-    bool jitter_;
-    uint32_t n_, a_ = 1, b_ = 1, set_ = 0, member_ = 0;
+    uint32_t a_ = 1, b_ = 1;
 };
 
 // Mitsuba's `ldsampler` (Kollig and Keller 2002): n' = 2^m. Each dimension (pair) takes point p of
 // the (0, 2)-sequence of Sobol dimensions 0 and 1, p a random permutation of the sample's index in
 // its set, XOR-shifted by a random 32-bit vector (a digital shift keeps the first 2^m points a
 // (0, m, 2)-net, one point in every elementary interval of area 2^-m, and makes each point uniform).
-class LdSampler final : public PixelSampleBase {
+class LdSampler final : public SetSampleBase {
 public:
     explicit LdSampler(const SamplerSetup& s)
-        : PixelSampleBase(s.seed), n_(sampler_sample_count(SamplerType::LdSampler, s.sample_count)) {}
-    void start_pixel_sample(ivec2 pixel, uint32_t i) {
-        start(pixel, i);
-        set_ = i / n_;
-        member_ = i % n_;
-    }
+        : SetSampleBase(s.seed, sampler_sample_count(SamplerType::LdSampler, s.sample_count), false) {}
+    void start_pixel_sample(ivec2 pixel, uint32_t i) { start_set(pixel, i); }
     float next_1d() {
-        const uint32_t seed = next_dim_seed(set_);
+        const uint32_t seed = next_seed();
         const uint32_t p = sampler_detail::permute(member_, n_, seed);
         return bits_to_unit(sobol_bits(p, 0) ^ uint32_t(mix_bits(seed)));
     }
     vec2 next_2d() {
-        const uint32_t seed = next_dim_seed(set_);
+        const uint32_t seed = next_seed();
         const uint32_t p = sampler_detail::permute(member_, n_, seed);
         const uint64_t shift = mix_bits(seed);
         return vec2(bits_to_unit(sobol_bits(p, 0) ^ uint32_t(shift)), bits_to_unit(sobol_bits(p, 1) ^ uint32_t(shift >> 32)));
     }
-
-private:
-    uint32_t n_, set_ = 0, member_ = 0;
 };
 
 // candela's `sobol`: each pixel has its own Owen-scrambled Sobol sequence (Burley 2020's
@@ -331,18 +329,15 @@ private:
 // The array has p + 1 columns only; a draw that does not fit starts the next group, a fresh array
 // (own row permutation; a 2D draw never straddles two). Mitsuba instead wraps l mod p, so that its
 // dimensions repeat past p + 1. jitter as for stratified.
-class OrthogonalSampler final : public PixelSampleBase {
+class OrthogonalSampler final : public SetSampleBase {
 public:
     explicit OrthogonalSampler(const SamplerSetup& s)
-        : PixelSampleBase(s.seed), jitter_(s.desc.jitter),
-          n_(sampler_sample_count(SamplerType::Orthogonal, s.sample_count)) {
+        : SetSampleBase(s.seed, sampler_sample_count(SamplerType::Orthogonal, s.sample_count), s.desc.jitter) {
         p_ = 2;
         while (p_ * p_ < n_) ++p_;
     }
     void start_pixel_sample(ivec2 pixel, uint32_t i) {
-        start(pixel, i);
-        set_ = i / n_;
-        member_ = i % n_;
+        start_set(pixel, i);
         group_ = ~0u;  // no group yet: the first draw starts group 0
         col_ = p_ + 1;
     }
@@ -371,14 +366,13 @@ private:
     // Column c of the row: c = 1 is a1, else a0 + l a1 with l = 0 (c = 0) or c - 1.
     uint32_t column(uint32_t c) const { return c == 1 ? a1_ : (a0_ + (c == 0 ? 0 : c - 1) * a1_) % p_; }
     float coordinate(uint32_t c, uint32_t sub) {
-        const uint32_t seed = next_dim_seed(set_);
+        const uint32_t seed = next_seed();
         const uint32_t stratum = sampler_detail::permute(column(c), p_, seed * 0x51633e2du + 1u);
         const uint32_t substratum = sampler_detail::permute(column(sub), p_, seed * 0x68bc21ebu + 2u);
-        const float j = jitter_ ? rng().next_float() : 0.5f;
+        const float j = jit();
         return sampler_detail::below_one((float(stratum) + (float(substratum) + j) / float(p_)) / float(p_));
     }
-    bool jitter_;
-    uint32_t n_, p_ = 2, set_ = 0, member_ = 0, group_ = 0, col_ = 0, a0_ = 0, a1_ = 0;
+    uint32_t p_ = 2, group_ = 0, col_ = 0, a0_ = 0, a1_ = 0;
 };
 
 // The sampler of type S for a setup.
