@@ -59,6 +59,7 @@ case "$mode" in
   --tsan)
     if [ ! -f build-tsan/build.ninja ]; then
       cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCANDELA_VIEWER=OFF -DCANDELA_BENCH=OFF -DCANDELA_MPI=OFF \
+        -DCANDELA_TEST_FILES="test_session.cpp;test_viewer_front_end.cpp;test_scene_split.cpp" \
         -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" >/dev/null
     fi
     cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2
