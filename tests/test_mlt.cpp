@@ -1,5 +1,5 @@
-// Metropolis light transport: the primary-sample-space sampler (sampling/pss_sampler.h) and
-// PSSMLT over the path tracer (integrator/mlt/pssmlt.h, docs/mlt.md).
+// Metropolis light transport: the primary-sample-space sampler (sampling/pss_sampler.h),
+// PSSMLT over the path tracer and MMLT over BDPT (integrator/mlt/pssmlt.h, docs/mlt.md).
 //
 //  * Mlt_DetailedBalance: the real mutation code (PssSampler with Metropolis acceptance) on a toy
 //    integrand of known shape over [0,1)^3 whose third coordinate is only drawn on half the domain
@@ -17,6 +17,8 @@
 //    the reference's, Welch t-test Sidak-corrected over blocks x channels; a 3% brighter control is
 //    rejected. Both scenes hide the emitters from the camera (cornell()). Many short chains: their
 //    start states are independent, so the runs' spread falls faster than with few long chains.
+//  * Mlt_Mmlt*: MMLT's bootstrap b and its image against the path tracer on the Cornell box at max
+//    depth 5 (MMLT caps the depth), and its determinism, the same ways.
 //  * Mlt_Deterministic: 1 and 2 threads, one pass against several, and a pass that has to replay
 //    the chains (after another render evicted them) give the same film bit for bit.
 //  * Mlt_Xml: <integrator type="pssmlt"> and its parameters.
@@ -128,9 +130,10 @@ std::pair<double, double> toy_chi2(const std::vector<ToyState>& xs) {
 // hide_emitters: the lamp seen directly would hold most of the chains' time and of b's variance
 // (its pixels are exact in both estimators anyway), and the test's budget is better spent on the
 // light the walls carry.
-std::shared_ptr<const Scene> cornell(int res) {
+std::shared_ptr<const Scene> cornell(int res, int max_depth = -1) {
     SceneDescription d = make_cornell_box();
     d.settings.width = d.settings.height = res;
+    d.settings.max_depth = max_depth;
     d.settings.integrator.hide_emitters = true;
     return build_scene(std::move(d), "auto");
 }
@@ -194,14 +197,14 @@ double compare_blocks(const BlockRuns& a, const BlockRuns& b, double scale, doub
 }
 
 void agreement(const Scene& scene, const MltParams& m, int K, int mlt_spp, int ref_spp, int block,
-               IntegratorType ref = IntegratorType::Path) {
-    const BlockRuns mlt = runs(scene, IntegratorType::Pssmlt, K, mlt_spp, block, 100, &m);
+               IntegratorType ref = IntegratorType::Path, IntegratorType type = IntegratorType::Pssmlt) {
+    const BlockRuns mlt = runs(scene, type, K, mlt_spp, block, 100, &m);
     const BlockRuns pt = runs(scene, ref, K, ref_spp, block, 200);
     double t = 0, t_ctl = 0;
     const double p = compare_blocks(mlt, pt, 1.0, &t);
     const double p_ctl = compare_blocks(mlt, pt, 1.03, &t_ctl);
     const MltStats s = pssmlt_stats();
-    std::printf("  pssmlt vs path: %d tiles x 3, family p = %.3g (max |t| %.2f); 3%% brighter: p = %.3g (max |t| %.2f)\n"
+    std::printf("  mlt vs reference: %d tiles x 3, family p = %.3g (max |t| %.2f); 3%% brighter: p = %.3g (max |t| %.2f)\n"
                 "  acceptance: small %.3f, large %.3f; b = %.5g +- %.2g\n",
                 mlt.tiles, p, t, p_ctl, t_ctl, double(s.small_accepted) / double(std::max<uint64_t>(1, s.small_proposed)),
                 double(s.large_accepted) / double(std::max<uint64_t>(1, s.large_proposed)), s.b, s.b_std_error);
@@ -243,11 +246,12 @@ std::shared_ptr<const Scene> mirror_glass(int res) {
     return build_scene(std::move(d), "auto");
 }
 
-void bootstrap_agreement(const Scene& scene, int B, IntegratorType ref, int K, int spp) {
+void bootstrap_agreement(const Scene& scene, int B, IntegratorType ref, int K, int spp,
+                         IntegratorType type = IntegratorType::Pssmlt) {
     MltParams m;
     m.bootstrap_samples = B;
     const int w = scene.settings.width, h = scene.settings.height;
-    const MltStats bs = pssmlt_bootstrap(*with(scene, IntegratorType::Pssmlt, 5, &m), w, h, 2);
+    const MltStats bs = pssmlt_bootstrap(*with(scene, type, 5, &m), w, h, 2);
     RunningStats pt;
     for (int k = 0; k < K; ++k) {
         Film f(w, h);
@@ -270,6 +274,18 @@ TEST(Mlt, BootstrapMatchesPathTracer) {
     bootstrap_agreement(*cornell(32), 200000, IntegratorType::Path, 12, 16);
 }
 
+TEST(Mlt, MmltBootstrapMatchesPathTracer) {
+    bootstrap_agreement(*cornell(32, 5), 200000, IntegratorType::Path, 12, 16, IntegratorType::Mmlt);
+}
+
+TEST(Mlt, MmltAgreesWithPathOnTheCornellBox) {
+    auto scene = cornell(32, 5);
+    MltParams m;
+    m.bootstrap_samples = 100000;  // b's spread per path is larger than pssmlt's (one strategy x their count)
+    m.chains = 2048;
+    agreement(*scene, m, 16, 48, 32, 16, IntegratorType::Path, IntegratorType::Mmlt);
+}
+
 TEST(Mlt, AgreesWithPathOnTheCornellBox) {
     auto scene = cornell(32);
     MltParams m;
@@ -286,12 +302,13 @@ TEST(Mlt, AgreesWithPathOnTheMirrorGlassBox) {
     agreement(*scene, m, 16, 48, 16, 16, IntegratorType::Bdpt);
 }
 
-TEST(Mlt, Deterministic) {
-    auto scene = cornell(24);
+namespace {
+void determinism(IntegratorType type) {
+    auto scene = cornell(24, type == IntegratorType::Mmlt ? 4 : -1);
     MltParams m;
     m.bootstrap_samples = 4000;
     m.chains = 37;  // not a divisor of the pixel count: uneven shares
-    auto sc = with(*scene, IntegratorType::Pssmlt, 9, &m);
+    auto sc = with(*scene, type, 9, &m);
     Film one(24, 24), two(24, 24), split(24, 24), replayed(24, 24);
     Renderer::render_pass(*sc, one, 0, 4, 1);
     Renderer::render_pass(*sc, two, 0, 4, 2);
@@ -302,13 +319,17 @@ TEST(Mlt, Deterministic) {
     // Another render in between evicts the chains: the next pass rebuilds and replays them.
     Renderer::render_pass(*sc, replayed, 0, 2, 2);
     Film other(24, 24);
-    Renderer::render_pass(*with(*scene, IntegratorType::Pssmlt, 10, &m), other, 0, 1, 2);
+    Renderer::render_pass(*with(*scene, type, 10, &m), other, 0, 1, 2);
     Renderer::render_pass(*sc, replayed, 2, 2, 2);
     EXPECT_TRUE(films_equal(one, replayed)) << "a replayed pass differs";
     EXPECT_FALSE(films_equal(one, other));
     EXPECT_EQ(one.splat_paths(), uint64_t(4 * 24 * 24));
     EXPECT_EQ(one.nonfinite_count(), 0u);
 }
+}  // namespace
+
+TEST(Mlt, Deterministic) { determinism(IntegratorType::Pssmlt); }
+TEST(Mlt, MmltDeterministic) { determinism(IntegratorType::Mmlt); }
 
 TEST(Mlt, Xml) {
     using namespace candela::test;
@@ -338,4 +359,10 @@ TEST(Mlt, Xml) {
     SceneDescription c = load_scene(d + "/c.xml");
     EXPECT_EQ(c.settings.spp, 8);
     EXPECT_EQ(c.settings.integrator.mlt.chains, 1000);
+    write_text(d + "/m.xml", scene_with("<integrator type=\"mmlt\"><integer name=\"max_depth\" value=\"6\"/>"
+                                        "<integer name=\"chains\" value=\"9\"/></integrator>"));
+    SceneDescription mm = load_scene(d + "/m.xml");
+    EXPECT_EQ(mm.settings.integrator.type, IntegratorType::Mmlt);
+    EXPECT_EQ(mm.settings.max_depth, 5);
+    EXPECT_EQ(mm.settings.integrator.mlt.chains, 9);
 }

@@ -13,6 +13,7 @@ enum class IntegratorType {
     Ptracer, // ptracer (light tracing, splats only): integrator/ptracer/
     Bdpt,    // bdpt (bidirectional path tracing, camera samples and splats): integrator/bdpt/
     Pssmlt,  // pssmlt (primary-sample-space Metropolis over the path tracer, splats only): integrator/mlt/
+    Mmlt,    // mmlt (multiplexed Metropolis over BDPT's strategies, splats only): integrator/mlt/
 };
 
 // Metropolis light transport's parameters (docs/mlt.md has the reasons for the defaults).
@@ -58,7 +59,7 @@ struct IntegratorDesc {
     // direct: samples per shading point of each strategy, combined by the power heuristic with the
     // sample counts in the weights (Mitsuba's direct.cpp).
     int emitter_samples = 1, bsdf_samples = 1;
-    MltParams mlt;  // pssmlt
+    MltParams mlt;  // pssmlt, mmlt
     // aov wrapper: the layers written beside the nested integrator's image.
     std::vector<AovSpec> aovs;
 };

@@ -13,6 +13,7 @@ std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
         case IntegratorType::Ptracer: return std::make_unique<LightTracerPass>();
         case IntegratorType::Bdpt: return std::make_unique<BdptPass>();
         case IntegratorType::Pssmlt: return std::make_unique<PssmltPass>();
+        case IntegratorType::Mmlt: return std::make_unique<MmltPass>();
         case IntegratorType::Path: break;
     }
     return std::make_unique<PathPass>();

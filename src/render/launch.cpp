@@ -28,8 +28,10 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
             throw Error("--integrator ptracer: the scene's aov or moment integrator needs camera rays, which ptracer has none of");
         if (*ov.integrator == IntegratorType::Bdpt && !st.integrator.aovs.empty())
             throw Error("--integrator bdpt: the scene's aov or moment integrator is not rendered by bdpt");
-        if (*ov.integrator == IntegratorType::Pssmlt && !st.integrator.aovs.empty())
-            throw Error("--integrator pssmlt: the scene's aov or moment integrator needs camera rays per pixel");
+        if ((*ov.integrator == IntegratorType::Pssmlt || *ov.integrator == IntegratorType::Mmlt) &&
+            !st.integrator.aovs.empty())
+            throw Error(std::string("--integrator ") + integrator_type_name(*ov.integrator) +
+                        ": the scene's aov or moment integrator needs camera rays per pixel");
     }
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
@@ -49,7 +51,8 @@ IntegratorType parse_integrator_type(const std::string& s) {
     if (s == "ptracer") return IntegratorType::Ptracer;
     if (s == "bdpt") return IntegratorType::Bdpt;
     if (s == "pssmlt") return IntegratorType::Pssmlt;
-    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer, bdpt or pssmlt)");
+    if (s == "mmlt") return IntegratorType::Mmlt;
+    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer, bdpt, pssmlt or mmlt)");
 }
 
 const char* integrator_type_name(IntegratorType t) {
@@ -58,6 +61,7 @@ const char* integrator_type_name(IntegratorType t) {
         case IntegratorType::Ptracer: return "ptracer";
         case IntegratorType::Bdpt: return "bdpt";
         case IntegratorType::Pssmlt: return "pssmlt";
+        case IntegratorType::Mmlt: return "mmlt";
         default: return "path";
     }
 }

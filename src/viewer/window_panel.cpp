@@ -106,14 +106,15 @@ void Viewer::panel() {
         // The aov and moment wrappers need camera rays: ptracer is offered without them only.
         const bool wrapped = !st.integrator.aovs.empty();
         static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer,
-                                                IntegratorType::Bdpt, IntegratorType::Pssmlt};
+                                                IntegratorType::Bdpt, IntegratorType::Pssmlt, IntegratorType::Mmlt};
         int type = st.integrator.type == IntegratorType::Direct    ? 1
                    : st.integrator.type == IntegratorType::Ptracer ? 2
                    : st.integrator.type == IntegratorType::Bdpt    ? 3
                    : st.integrator.type == IntegratorType::Pssmlt  ? 4
+                   : st.integrator.type == IntegratorType::Mmlt    ? 5
                                                                    : 0;
         if (ImGui::Combo("integrator", &type,
-                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0pssmlt (Metropolis)\0")) {
+                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0pssmlt (Metropolis)\0mmlt (multiplexed Metropolis)\0")) {
             st.integrator.type = kTypes[type];
             fe_->params_changed(viewer_now());
         }
@@ -122,8 +123,9 @@ void Viewer::panel() {
                               "direct: direct lighting only (Mitsuba's direct)\n"
                               "ptracer: light tracing, every light-path vertex splatted through the camera\n"
                               "bdpt: bidirectional path tracing, every (s, t) strategy weighted by MIS\n"
-                              "pssmlt: primary-sample-space Metropolis over the path tracer (docs/mlt.md)");
-        if (st.integrator.type == IntegratorType::Pssmlt) {
+                              "pssmlt: primary-sample-space Metropolis over the path tracer (docs/mlt.md)\n"
+                              "mmlt: multiplexed Metropolis over BDPT's strategies, chains per path length");
+        if (st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt) {
             // The chains as they run: acceptance of small and large steps, and the bootstrap's b.
             const MltStats ms = pssmlt_stats();
             if (ms.valid) {

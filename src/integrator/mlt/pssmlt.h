@@ -28,7 +28,18 @@ public:
                           const std::atomic<bool>* cancel) const override;
 };
 
-// The chains' statistics after the last pssmlt pass (for the viewer's panel and the tests).
+// Multiplexed MLT over BDPT (Hachisuka et al. 2014): the same chains, each at a path length (depth)
+// drawn with its start state from the bootstrap (state i has depth i mod (max depth + 1)), its
+// states of three streams (camera path, light path, connection) evaluated by one BDPT strategy
+// (s, t) of that depth chosen by the connection stream, weighted by MIS over the depth's strategies
+// (Bdpt::sample_strategy). An unbounded max depth is capped at 12 scattering events.
+class MmltPass final : public Integrator {
+public:
+    PassStats render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
+                          const std::atomic<bool>* cancel) const override;
+};
+
+// The chains' statistics after the last pssmlt or mmlt pass (for the viewer's panel and the tests).
 struct MltStats {
     double b = 0;          // the bootstrap's normalisation: mean luminance over the image
     double b_std_error = 0;  // its standard error (sample standard deviation / sqrt(bootstrap_samples))
@@ -39,7 +50,8 @@ struct MltStats {
 };
 MltStats pssmlt_stats();
 
-// The bootstrap alone (tests): b and its standard error for the scene at this film size.
+// The bootstrap alone (tests): b and its standard error for the scene (pssmlt or mmlt, by its
+// integrator type) at this film size.
 MltStats pssmlt_bootstrap(const Scene& scene, int width, int height, int threads);
 
 }  // namespace candela

@@ -106,16 +106,17 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         p.report_unused();
         return IntegratorRole::Renders;
     }
-    if (type == "pssmlt") {
-        // Primary-sample-space MLT over the path tracer (integrator/mlt/, docs/mlt.md).
+    if (type == "pssmlt" || type == "mmlt") {
+        // Primary-sample-space MLT over the path tracer, multiplexed MLT over BDPT
+        // (integrator/mlt/, docs/mlt.md).
         read_depths(p, st);
-        d.type = IntegratorType::Pssmlt;
+        d.type = type == "mmlt" ? IntegratorType::Mmlt : IntegratorType::Pssmlt;
         d.hide_emitters = p.get_bool("hide_emitters", false);
         MltParams& m = d.mlt;
         m.bootstrap_samples = p.get_int("bootstrap_samples", m.bootstrap_samples);
-        if (m.bootstrap_samples < 1) throw p.error("bootstrap_samples", "pssmlt needs at least one bootstrap sample");
+        if (m.bootstrap_samples < 1) throw p.error("bootstrap_samples", "needs at least one bootstrap sample");
         m.chains = p.get_int("chains", m.chains);
-        if (m.chains < 1) throw p.error("chains", "pssmlt needs at least one chain");
+        if (m.chains < 1) throw p.error("chains", "needs at least one chain");
         m.mutations_per_pixel = p.get_int("mutations_per_pixel", 0);
         if (p.has("mutations_per_pixel") && m.mutations_per_pixel < 1)
             throw p.error("mutations_per_pixel", "must be at least 1");
@@ -140,7 +141,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, moment, aov)");
+                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov)");
 }
 
 FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {
