@@ -233,7 +233,8 @@ int run_headless(const HeadlessOptions& opt) {
         if (st.sampler.type != SamplerType::Independent)
             throw Error(src, 0, std::string("--target-error needs the independent sampler (the halves must be "
                                             "independent), not ") + sampler_type_name(st.sampler.type));
-        if (st.integrator.type == IntegratorType::Ptracer || st.integrator.type == IntegratorType::Bdpt)
+        if (st.integrator.type == IntegratorType::Ptracer || st.integrator.type == IntegratorType::Bdpt ||
+            st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt)
             throw Error(src, 0, "--target-error needs camera paths per pixel; the splats of ptracer and bdpt land anywhere");
         if (film.weighted()) throw Error(src, 0, "--target-error needs the box reconstruction filter");
         if (!aovs.empty()) throw Error(src, 0, "--target-error does not render the aov integrator's layers");

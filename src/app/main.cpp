@@ -55,10 +55,12 @@ int main(int argc, char** argv) {
     std::string integrator;
     auto* i_opt = app.add_option("--integrator", integrator,
                                  "Integrator: path (the path tracer), direct (direct lighting), ptracer (light\n"
-                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer) or bdpt\n"
-                                 "(bidirectional path tracing, every (s, t) strategy, MIS); replaces the scene's\n"
-                                 "<integrator> type, keeping its depths and hide_emitters")
-                      ->check(CLI::IsMember({"path", "direct", "ptracer", "bdpt"}));
+                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer), bdpt\n"
+                                 "(bidirectional path tracing, every (s, t) strategy, MIS) or pssmlt (primary-sample-space\n"
+                                 "Metropolis over the path tracer) or mmlt (multiplexed Metropolis over BDPT; for both\n"
+                                 "the sample count is mutations per pixel, docs/mlt.md);\n"
+                                 "replaces the scene's <integrator> type, keeping its depths and hide_emitters")
+                      ->check(CLI::IsMember({"path", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
     auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
                                        "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"

@@ -12,6 +12,19 @@ enum class IntegratorType {
     Direct,  // direct: integrator/direct/
     Ptracer, // ptracer (light tracing, splats only): integrator/ptracer/
     Bdpt,    // bdpt (bidirectional path tracing, camera samples and splats): integrator/bdpt/
+    Pssmlt,  // pssmlt (primary-sample-space Metropolis over the path tracer, splats only): integrator/mlt/
+    Mmlt,    // mmlt (multiplexed Metropolis over BDPT's strategies, splats only): integrator/mlt/
+};
+
+// Metropolis light transport's parameters (docs/mlt.md has the reasons for the defaults).
+struct MltParams {
+    int bootstrap_samples = 100000;  // paths that estimate b and seed the chains (pbrt-v3)
+    int chains = 1000;               // Markov chains (pbrt-v3): many short chains hide start-up bias
+    float sigma = 0.01f;             // small-step standard deviation in primary sample space (pbrt-v3)
+    float large_step_probability = 0.3f;  // pbrt-v3's default
+    // The XML's mutations_per_pixel (0: not given): it becomes the scene's sample_count, the
+    // render's total mutations per pixel (a pass of n "samples per pixel" is n x pixels mutations).
+    int mutations_per_pixel = 0;
 };
 
 // Arbitrary output variables of Mitsuba's `aov` wrapper: values of the first surface the camera
@@ -46,6 +59,7 @@ struct IntegratorDesc {
     // direct: samples per shading point of each strategy, combined by the power heuristic with the
     // sample counts in the weights (Mitsuba's direct.cpp).
     int emitter_samples = 1, bsdf_samples = 1;
+    MltParams mlt;  // pssmlt, mmlt
     // aov wrapper: the layers written beside the nested integrator's image.
     std::vector<AovSpec> aovs;
 };

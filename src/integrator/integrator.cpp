@@ -1,6 +1,7 @@
 #include "integrator/integrator.h"
 #include "integrator/bdpt/bdpt.h"
 #include "integrator/direct/direct.h"
+#include "integrator/mlt/pssmlt.h"
 #include "integrator/path/path_pass.h"
 #include "integrator/ptracer/ptracer.h"
 
@@ -11,6 +12,8 @@ std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
         case IntegratorType::Direct: return std::make_unique<DirectPass>();
         case IntegratorType::Ptracer: return std::make_unique<LightTracerPass>();
         case IntegratorType::Bdpt: return std::make_unique<BdptPass>();
+        case IntegratorType::Pssmlt: return std::make_unique<PssmltPass>();
+        case IntegratorType::Mmlt: return std::make_unique<MmltPass>();
         case IntegratorType::Path: break;
     }
     return std::make_unique<PathPass>();

@@ -28,6 +28,10 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
             throw Error("--integrator ptracer: the scene's aov or moment integrator needs camera rays, which ptracer has none of");
         if (*ov.integrator == IntegratorType::Bdpt && !st.integrator.aovs.empty())
             throw Error("--integrator bdpt: the scene's aov or moment integrator is not rendered by bdpt");
+        if ((*ov.integrator == IntegratorType::Pssmlt || *ov.integrator == IntegratorType::Mmlt) &&
+            !st.integrator.aovs.empty())
+            throw Error(std::string("--integrator ") + integrator_type_name(*ov.integrator) +
+                        ": the scene's aov or moment integrator needs camera rays per pixel");
     }
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
@@ -46,7 +50,9 @@ IntegratorType parse_integrator_type(const std::string& s) {
     if (s == "direct") return IntegratorType::Direct;
     if (s == "ptracer") return IntegratorType::Ptracer;
     if (s == "bdpt") return IntegratorType::Bdpt;
-    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer or bdpt)");
+    if (s == "pssmlt") return IntegratorType::Pssmlt;
+    if (s == "mmlt") return IntegratorType::Mmlt;
+    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer, bdpt, pssmlt or mmlt)");
 }
 
 const char* integrator_type_name(IntegratorType t) {
@@ -54,6 +60,8 @@ const char* integrator_type_name(IntegratorType t) {
         case IntegratorType::Direct: return "direct";
         case IntegratorType::Ptracer: return "ptracer";
         case IntegratorType::Bdpt: return "bdpt";
+        case IntegratorType::Pssmlt: return "pssmlt";
+        case IntegratorType::Mmlt: return "mmlt";
         default: return "path";
     }
 }

@@ -25,7 +25,7 @@ struct SceneOverrides {
 std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
-IntegratorType parse_integrator_type(const std::string& s);  // path | direct | ptracer | bdpt
+IntegratorType parse_integrator_type(const std::string& s);  // path | direct | ptracer | bdpt | pssmlt | mmlt
 const char* integrator_type_name(IntegratorType t);
 const char* sampling_mode_name(SamplingMode m);
 // --sampler NAME: a sampler_type_name; unknown names are errors.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <thread>
+#include "integrator/mlt/pssmlt.h"
 #include "viewer/panel.h"
 #include "viewer/window.h"
 
@@ -105,13 +106,15 @@ void Viewer::panel() {
         // The aov and moment wrappers need camera rays: ptracer is offered without them only.
         const bool wrapped = !st.integrator.aovs.empty();
         static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer,
-                                                IntegratorType::Bdpt};
+                                                IntegratorType::Bdpt, IntegratorType::Pssmlt, IntegratorType::Mmlt};
         int type = st.integrator.type == IntegratorType::Direct    ? 1
                    : st.integrator.type == IntegratorType::Ptracer ? 2
                    : st.integrator.type == IntegratorType::Bdpt    ? 3
+                   : st.integrator.type == IntegratorType::Pssmlt  ? 4
+                   : st.integrator.type == IntegratorType::Mmlt    ? 5
                                                                    : 0;
         if (ImGui::Combo("integrator", &type,
-                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0")) {
+                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0pssmlt (Metropolis)\0mmlt (multiplexed Metropolis)\0")) {
             st.integrator.type = kTypes[type];
             fe_->params_changed(viewer_now());
         }
@@ -119,7 +122,22 @@ void Viewer::panel() {
             ImGui::SetTooltip("path: path tracing with next-event estimation and MIS\n"
                               "direct: direct lighting only (Mitsuba's direct)\n"
                               "ptracer: light tracing, every light-path vertex splatted through the camera\n"
-                              "bdpt: bidirectional path tracing, every (s, t) strategy weighted by MIS");
+                              "bdpt: bidirectional path tracing, every (s, t) strategy weighted by MIS\n"
+                              "pssmlt: primary-sample-space Metropolis over the path tracer (docs/mlt.md)\n"
+                              "mmlt: multiplexed Metropolis over BDPT's strategies, chains per path length");
+        if (st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt) {
+            // The chains as they run: acceptance of small and large steps, and the bootstrap's b.
+            const MltStats ms = pssmlt_stats();
+            if (ms.valid) {
+                auto rate = [](uint64_t a, uint64_t n) { return n ? 100.0 * double(a) / double(n) : 0.0; };
+                ImGui::Text("MLT: accept small %.1f%%, large %.1f%%, b %.4g", rate(ms.small_accepted, ms.small_proposed),
+                            rate(ms.large_accepted, ms.large_proposed), ms.b);
+                if (ImGui::IsItemHovered())
+                    ImGui::SetTooltip("b: the bootstrap's mean luminance over the image (+- %.2g), the chains' normalisation.\n"
+                                      "%llu mutations over %d chains.",
+                                      ms.b_std_error, (unsigned long long)ms.mutations, st.integrator.mlt.chains);
+            }
+        }
         int mode = int(st.sampling);
         if (ImGui::Combo("sampling", &mode, "light sampling\0BSDF sampling\0MIS\0")) {
             st.sampling = SamplingMode(mode);

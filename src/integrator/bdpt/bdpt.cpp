@@ -1,7 +1,7 @@
 // BDPT: the densities, the connections, and the passes (bdpt.h).
 #include "integrator/bdpt/bdpt.h"
 #include <omp.h>
-#include "integrator/tiles.h"
+#include "integrator/splat_pass.h"
 
 namespace candela {
 
@@ -224,89 +224,50 @@ float Bdpt::camera_visibility(const SurfaceInteraction& from, vec3 cam_p, PathSt
 
 namespace {
 
-// One sample index at a time over all tiles (as the light tracer's pass, ptracer.cpp): each
-// tile's camera samples go to their own pixels of a zeroed layer (the box filter: a pixel is
-// written by its tile only; other filters: the tile's FilmTile, merged in tile order), its splats
-// to its SplatTile, merged in tile order; then the layer is added to the film. The additions into
-// every sum thus happen in a fixed order whatever the threads and the passes, and the film is the
-// sum of per-index layers, as MPI's rank 0 rebuilds it.
+// The splat pass (integrator/splat_pass.h): each tile's camera samples go to their own pixels of
+// the zeroed layer (the box filter: a pixel is written by its tile only; other filters: the tile's
+// FilmTile, merged in tile order), its splats to its SplatTile.
 template <class S>
 PassStats bdpt_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
                     const std::atomic<bool>* cancel, const S& prototype) {
     const int w = film.width(), h = film.height();
-    const int tiles_x = (w + kTileSize - 1) / kTileSize, tiles_y = (h + kTileSize - 1) / kTileSize;
-    const int n_tiles = tiles_x * tiles_y;
+    const int n_tiles = ((w + kTileSize - 1) / kTileSize) * ((h + kTileSize - 1) / kTileSize);
     Camera camera = scene.camera;
     camera.set_film_size(w, h);
     const Bdpt bdpt(scene, camera, w, h);
     const bool weighted = film.weighted(), alpha = film.has_alpha();
     const PixelFilter filter(scene.settings.filter);
-    std::vector<SplatTile> tiles(static_cast<size_t>(n_tiles));
     std::vector<FilmTile> ftiles(weighted ? static_cast<size_t>(n_tiles) : 0);
-    Film layer(w, h);
-    layer.set_layout(weighted, film.aov_channels());
-    if (alpha) layer.enable_alpha();
     std::vector<std::unique_ptr<Bdpt::Workspace>> spaces(static_cast<size_t>(std::max(1, n_threads)));
-    std::atomic<uint64_t> total_rays{0};
-    std::atomic<bool> stopped{false};
-    uint64_t samples = 0, splats = 0;
-    for (int s = 0; s < spp; ++s) {
-        if (cancel && cancel->load(std::memory_order_relaxed)) stopped = true;
-        if (stopped) break;
-        layer.clear();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            if (stopped.load(std::memory_order_relaxed)) continue;
-            if (cancel && cancel->load(std::memory_order_relaxed)) {
-                stopped = true;
-                continue;
-            }
-            std::unique_ptr<Bdpt::Workspace>& wsp = spaces[size_t(omp_get_thread_num())];
-            if (!wsp) wsp = std::make_unique<Bdpt::Workspace>();
-            S sampler = prototype;
-            PathStats ps;
-            SplatTile& st = tiles[size_t(tile)];
-            st.clear();
-            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
-            if (weighted) ftiles[size_t(tile)].reset(film, tr.x0, tr.y0, tr.x1, tr.y1, filter.reach());
-            for (int y = tr.y0; y < tr.y1; ++y)
-                for (int x = tr.x0; x < tr.x1; ++x) {
-                    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                    bool covered = false;
-                    vec2 jitter(0.5f);
-                    vec3 L = bdpt.sample(sampler, ivec2(x, y), *wsp, st, ps, covered, jitter, nullptr);
-                    ++st.paths;
-                    if (!weighted) {
-                        layer.add_sample(ivec2(x, y), L);
-                        if (alpha) layer.add_coverage(ivec2(x, y), covered);
-                        continue;
-                    }
-                    if (!all_finite(L)) {
-                        layer.count_nonfinite();
-                        L = vec3(0.f);
-                    }
-                    layer.count_sample(ivec2(x, y));
-                    detail::splat(ftiles[size_t(tile)], filter, w, h, vec2(float(x), float(y)) + jitter, L, nullptr,
-                                  covered);
+    auto work = [&](uint32_t index, int tile, const detail::TileRange& tr, Film& layer, SplatTile& st, PathStats& ps) {
+        std::unique_ptr<Bdpt::Workspace>& wsp = spaces[size_t(omp_get_thread_num())];
+        if (!wsp) wsp = std::make_unique<Bdpt::Workspace>();
+        S sampler = prototype;
+        if (weighted) ftiles[size_t(tile)].reset(film, tr.x0, tr.y0, tr.x1, tr.y1, filter.reach());
+        for (int y = tr.y0; y < tr.y1; ++y)
+            for (int x = tr.x0; x < tr.x1; ++x) {
+                sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), index);
+                bool covered = false;
+                vec2 jitter(0.5f);
+                vec3 L = bdpt.sample(sampler, ivec2(x, y), *wsp, st, ps, covered, jitter, nullptr);
+                ++st.paths;
+                if (!weighted) {
+                    layer.add_sample(ivec2(x, y), L);
+                    if (alpha) layer.add_coverage(ivec2(x, y), covered);
+                    continue;
                 }
-            total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
-        }
-        if (stopped) break;  // a partial sample index is dropped whole: every pixel keeps its count
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            const SplatTile& st = tiles[size_t(tile)];
-            if (weighted) layer.merge(ftiles[size_t(tile)]);
-            layer.add_splats(st);
-            splats += st.pixel.size();
-            samples += st.paths;
-        }
-        film.add(layer);
-    }
-    PassStats out;
-    out.rays = total_rays.load();
-    out.samples = samples;
-    out.splats = splats;
-    out.completed = !stopped.load();
-    return out;
+                if (!all_finite(L)) {
+                    layer.count_nonfinite();
+                    L = vec3(0.f);
+                }
+                layer.count_sample(ivec2(x, y));
+                detail::splat(ftiles[size_t(tile)], filter, w, h, vec2(float(x), float(y)) + jitter, L, nullptr, covered);
+            }
+    };
+    auto merge_tile = [&](int tile, const detail::TileRange&, Film& layer) {
+        if (weighted) layer.merge(ftiles[size_t(tile)]);
+    };
+    return splat_pass(film, first_sample, spp, n_threads, cancel, work, merge_tile);
 }
 
 }  // namespace

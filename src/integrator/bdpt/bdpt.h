@@ -93,7 +93,21 @@ public:
     vec3 sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats& stats, bool& covered, vec2& jitter,
                 std::vector<StrategyRecord>* record) const;
 
+    // MMLT (integrator/mlt/): one strategy (s, t) of paths of `depth` scattering events, chosen
+    // uniformly among the depth's strategies by the sampler's stream 2 (which also gives the
+    // connection's numbers), the camera subpath of t vertices from stream 0 (its first two numbers:
+    // the film position, returned in `raster`, or the t = 1 splat's position), the light subpath
+    // of s vertices from stream 1. Returns the strategy's MIS-weighted contribution times the
+    // number of strategies: summed over the strategies, its expectation is the depth's image.
+    template <class S>
+    vec3 sample_strategy(S& sampler, int depth, Workspace& ws, PathStats& stats, vec2& raster) const;
+
 private:
+    template <class S>
+    int camera_subpath(S& sampler, ivec2 px, vec2 jitter, Workspace& ws, int max_cam, PathStats& stats) const;
+    template <class S>
+    int light_subpath(S& sampler, Workspace& ws, int max_light, PathStats& stats) const;
+
     const Scene& scene_;
     const Camera& camera_;
     int width_, height_;

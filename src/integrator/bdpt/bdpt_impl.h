@@ -107,16 +107,7 @@ int Bdpt::walk(S& sampler, Ray ray, vec3 beta, float pdf_sa, BdptVertex* path, S
 }
 
 template <class S>
-vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats& stats, bool& covered, vec2& jitter,
-                  std::vector<StrategyRecord>* record) const {
-    const Scene& sc = scene_;
-    const RenderSettings& st = sc.settings;
-    const int max_depth = st.max_depth;
-    const int max_cam = max_depth < 0 ? kBdptMaxVertices : std::min(max_depth + 2, kBdptMaxVertices);
-    const int max_light = max_depth < 0 ? kBdptMaxVertices : std::min(max_depth + 1, kBdptMaxVertices);
-
-    // The camera subpath.
-    jitter = sampler.next_2d();
+int Bdpt::camera_subpath(S& sampler, ivec2 px, vec2 jitter, Workspace& ws, int max_cam, PathStats& stats) const {
     const vec2 lens = camera_.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
     const Ray ray = camera_.generate_ray(px, jitter, lens);
     BdptVertex& z0 = ws.cam[0];
@@ -138,12 +129,15 @@ vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats
         z0.p = ray.o;
     }
     int nc = 1;
-    if (pdf_dir > 0.f)
+    if (pdf_dir > 0.f && max_cam > 1)
         nc = walk(sampler, ray, vec3(1.f), pdf_dir, ws.cam.data(), ws.cam_sh.get(), 1, max_cam, TransportMode::Radiance,
                   stats, true, false);
-    covered = nc > 1 && ws.cam[1].kind == BdptVertex::Kind::Surface;
+    return nc;
+}
 
-    // The light subpath.
+template <class S>
+int Bdpt::light_subpath(S& sampler, Workspace& ws, int max_light, PathStats& stats) const {
+    const Scene& sc = scene_;
     int nl = 0;
     if (!sc.lights.empty()) {
         const float u_sel = sampler.next_1d();
@@ -177,6 +171,23 @@ vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats
             if ((es->flags & kLightArea) && nl >= 2) y0.pdf_fwd = pdf_light_origin(y0, ws.light[1]);
         }
     }
+    return nl;
+}
+
+template <class S>
+vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats& stats, bool& covered, vec2& jitter,
+                  std::vector<StrategyRecord>* record) const {
+    const Scene& sc = scene_;
+    const RenderSettings& st = sc.settings;
+    const int max_depth = st.max_depth;
+    const int max_cam = max_depth < 0 ? kBdptMaxVertices : std::min(max_depth + 2, kBdptMaxVertices);
+    const int max_light = max_depth < 0 ? kBdptMaxVertices : std::min(max_depth + 1, kBdptMaxVertices);
+
+    // The camera subpath, then the light subpath.
+    jitter = sampler.next_2d();
+    const int nc = camera_subpath(sampler, px, jitter, ws, max_cam, stats);
+    covered = nc > 1 && ws.cam[1].kind == BdptVertex::Kind::Surface;
+    const int nl = light_subpath(sampler, ws, max_light, stats);
 
     // Every strategy, in a fixed order (the sampler's dimensions follow it).
     vec3 L(0.f);
@@ -202,6 +213,42 @@ vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats
             else L += c * w;
         }
     return L;
+}
+
+template <class S>
+vec3 Bdpt::sample_strategy(S& sampler, int depth, Workspace& ws, PathStats& stats, vec2& raster) const {
+    const RenderSettings& st = scene_.settings;
+    if (depth == 0 && st.integrator.hide_emitters) return vec3(0.f);
+    // The strategy: (0, 2) alone for depth 0 ((1, 1) is no strategy), else s uniform in 0..depth+1.
+    sampler.start_stream(2);
+    const int n_strategies = depth == 0 ? 1 : depth + 2;
+    const float u_s = sampler.next_1d();
+    const int s = depth == 0 ? 0 : std::min(int(u_s * float(n_strategies)), n_strategies - 1);
+    const int t = depth + 2 - s;
+    float u_l = 0.f;
+    vec2 u_p(0.f), u_lens(0.f);
+    if (s == 1) {
+        u_l = sampler.next_1d();
+        u_p = sampler.next_2d();
+    }
+    if (t == 1) u_lens = sampler.next_2d();
+    // The camera subpath of exactly t vertices from the film position the camera stream picks.
+    sampler.start_stream(0);
+    raster = sampler.next_2d() * vec2(float(width_), float(height_));
+    const ivec2 px(std::min(int(raster.x), width_ - 1), std::min(int(raster.y), height_ - 1));
+    const vec2 jitter = glm::clamp(raster - vec2(px), vec2(0.f), vec2(0x1.fffffep-1f));
+    if (camera_subpath(sampler, px, jitter, ws, t, stats) != t) return vec3(0.f);
+    // The light subpath of exactly s vertices (s = 1 samples its light in connect).
+    if (s >= 2) {
+        sampler.start_stream(1);
+        if (light_subpath(sampler, ws, s, stats) != s) return vec3(0.f);
+    }
+    float w = 0.f;
+    bool splat = false;
+    vec2 r(0.f);
+    const vec3 c = connect(ws, s, t, u_l, u_p, u_lens, stats, w, r, splat);
+    if (splat) raster = r;
+    return c * (w * float(n_strategies));
 }
 
 }  // namespace candela

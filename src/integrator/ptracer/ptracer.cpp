@@ -2,8 +2,7 @@
 // order so that the image does not depend on the thread count or on how the samples are split
 // into passes.
 #include "integrator/ptracer/ptracer.h"
-#include <omp.h>
-#include "integrator/tiles.h"
+#include "integrator/splat_pass.h"
 
 namespace candela {
 
@@ -14,67 +13,25 @@ namespace {
 template <bool DiffuseOnly, class S>
 PassStats light_tracer_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
                             const std::atomic<bool>* cancel, const S& prototype) {
-    const int w = film.width(), h = film.height();
-    const int tiles_x = (w + kTileSize - 1) / kTileSize, tiles_y = (h + kTileSize - 1) / kTileSize;
-    const int n_tiles = tiles_x * tiles_y;
     Camera camera = scene.camera;
-    camera.set_film_size(w, h);
-    const LightTracer tracer(scene, camera, w, h);
-    std::vector<SplatTile> tiles(static_cast<size_t>(n_tiles));
-    Film layer(w, h);
-    layer.set_layout(film.weighted(), film.aov_channels());
-    if (film.has_alpha()) layer.enable_alpha();
-    std::atomic<uint64_t> total_rays{0};
-    std::atomic<bool> stopped{false};
-    uint64_t samples = 0, splats = 0;
-    // One sample index at a time over all tiles, then the tiles' splats in tile order: the
-    // additions into a pixel's splat sum happen in the order (sample index, tile, pixel, vertex)
-    // whatever the threads and the passes (as the weighted film's merge, integrator/tiles.h).
-    for (int s = 0; s < spp; ++s) {
-        if (cancel && cancel->load(std::memory_order_relaxed)) stopped = true;
-        if (stopped) break;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            if (stopped.load(std::memory_order_relaxed)) continue;
-            if (cancel && cancel->load(std::memory_order_relaxed)) {
-                stopped = true;
-                continue;
+    camera.set_film_size(film.width(), film.height());
+    const LightTracer tracer(scene, camera, film.width(), film.height());
+    // The splat pass (integrator/splat_pass.h): the light paths' splats only; each pixel counts
+    // the samples that own its light paths.
+    auto work = [&](uint32_t index, int, const detail::TileRange& tr, Film&, SplatTile& st, PathStats& ps) {
+        S sampler = prototype;
+        for (int y = tr.y0; y < tr.y1; ++y)
+            for (int x = tr.x0; x < tr.x1; ++x) {
+                sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), index);
+                tracer.trace<S, DiffuseOnly>(sampler, st, ps);
+                ++st.paths;
             }
-            S sampler = prototype;
-            PathStats ps;
-            SplatTile& st = tiles[size_t(tile)];
-            st.clear();
-            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
-            for (int y = tr.y0; y < tr.y1; ++y)
-                for (int x = tr.x0; x < tr.x1; ++x) {
-                    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                    tracer.trace<S, DiffuseOnly>(sampler, st, ps);
-                    ++st.paths;
-                }
-            total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
-        }
-        if (stopped) break;  // a partial sample index is dropped whole: every pixel keeps its count
-        // The index's splats go into a zeroed layer that is then added to the film, so that the
-        // film is the sum of per-index layers in index order: what MPI's rank 0 rebuilds from
-        // layers rendered elsewhere (Film::add, docs/distributed.md), bit for bit.
-        layer.clear();
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            const SplatTile& st = tiles[size_t(tile)];
-            layer.add_splats(st);
-            splats += st.pixel.size();
-            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
-            for (int y = tr.y0; y < tr.y1; ++y)
-                for (int x = tr.x0; x < tr.x1; ++x) layer.count_sample(ivec2(x, y));
-            samples += st.paths;
-        }
-        film.add(layer);
-    }
-    PassStats out;
-    out.rays = total_rays.load();
-    out.samples = samples;
-    out.splats = splats;
-    out.completed = !stopped.load();
-    return out;
+    };
+    auto merge_tile = [&](int, const detail::TileRange& tr, Film& layer) {
+        for (int y = tr.y0; y < tr.y1; ++y)
+            for (int x = tr.x0; x < tr.x1; ++x) layer.count_sample(ivec2(x, y));
+    };
+    return splat_pass(film, first_sample, spp, n_threads, cancel, work, merge_tile);
 }
 
 }  // namespace

@@ -106,6 +106,28 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         p.report_unused();
         return IntegratorRole::Renders;
     }
+    if (type == "pssmlt" || type == "mmlt") {
+        // Primary-sample-space MLT over the path tracer, multiplexed MLT over BDPT
+        // (integrator/mlt/, docs/mlt.md).
+        read_depths(p, st);
+        d.type = type == "mmlt" ? IntegratorType::Mmlt : IntegratorType::Pssmlt;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        MltParams& m = d.mlt;
+        m.bootstrap_samples = p.get_int("bootstrap_samples", m.bootstrap_samples);
+        if (m.bootstrap_samples < 1) throw p.error("bootstrap_samples", "needs at least one bootstrap sample");
+        m.chains = p.get_int("chains", m.chains);
+        if (m.chains < 1) throw p.error("chains", "needs at least one chain");
+        m.mutations_per_pixel = p.get_int("mutations_per_pixel", 0);
+        if (p.has("mutations_per_pixel") && m.mutations_per_pixel < 1)
+            throw p.error("mutations_per_pixel", "must be at least 1");
+        m.sigma = p.get_float("sigma", m.sigma);
+        if (!(m.sigma > 0.f && m.sigma <= 1.f)) throw p.error("sigma", "must be in (0, 1]");
+        m.large_step_probability = p.get_float("large_step_probability", m.large_step_probability);
+        if (!(m.large_step_probability >= 0.f && m.large_step_probability <= 1.f))
+            throw p.error("large_step_probability", "must be in [0, 1]");
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
     if (type == "moment") {
         // The image is the nested integrator's; the caller, which knows the nested integrator's
         // name, adds the moment channels (AovType::Moment) once the nesting is read.
@@ -119,7 +141,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, ptracer, bdpt, moment, aov)");
+                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov)");
 }
 
 FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {

@@ -18,6 +18,9 @@ void load_integrator(XmlLoader& L, pugi::xml_node n) {
                 throw L.error(n, "ptracer cannot be nested in an aov or moment integrator (it traces no camera rays)");
             if (s.integrator.type == IntegratorType::Bdpt && (level > 0 || !moment.empty()))
                 throw L.error(n, "bdpt cannot be nested in an aov or moment integrator (not supported)");
+            if ((s.integrator.type == IntegratorType::Pssmlt || s.integrator.type == IntegratorType::Mmlt) &&
+                (level > 0 || !moment.empty()))
+                throw L.error(n, "pssmlt and mmlt cannot be nested in an aov or moment integrator (their image is all splats)");
             L.finish(o);
             break;
         }

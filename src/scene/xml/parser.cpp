@@ -876,6 +876,10 @@ SceneDescription XmlLoader::load() {
             scene_.settings.spp = 4;
             scene_.settings.filter = gaussian_filter();
         }
+        // pssmlt's mutations_per_pixel is the render's sample count, whichever of the sensor and
+        // the integrator came first.
+        if (scene_.settings.integrator.mlt.mutations_per_pixel > 0)
+            scene_.settings.spp = scene_.settings.integrator.mlt.mutations_per_pixel;
     } catch (const Error& e) {
         // What Mitsuba 3's upgrade rules leave for a 0.x/1.x file (other plugin names, parameters
         // that were removed) surfaces as an ordinary error; say which rules were applied.
