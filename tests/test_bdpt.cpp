@@ -15,7 +15,6 @@
 //  * Bdpt.SameFilmAtAnyThreadCountAndPassSplit; Bdpt.StrategyImagesSumToTheImage; XML and CLI.
 #include <gtest/gtest.h>
 #include <cstring>
-#include <map>
 #include <random>
 #include "core/error.h"
 #include "film/image_io.h"
@@ -23,53 +22,30 @@
 #include "render/renderer.h"
 #include "scene/cornell.h"
 #include "scene/loaders.h"
+#include "support/agreement.h"
 #include "support/run.h"
 #include "support/stats.h"
 
 using namespace candela;
 using namespace candela::stats;
+using namespace candela::test;
 
 namespace {
 
 constexpr double kAlpha = 0.01;
 
 ImageEstimate batches(const Scene& scene, SceneParams p, IntegratorType type, int K, int spp, uint64_t base) {
-    std::vector<std::unique_ptr<Film>> films;
-    std::vector<const Film*> ptrs;
     p.settings.integrator.type = type;
     // The light seen directly (a few pixels at 16 x 16, partly covered) makes the whole image's
     // mean 2-5% noisy through the pixel jitter alone, the same in both integrators: hidden
     // (Mitsuba's hide_emitters, in both), and the jitter stratified.
     p.settings.integrator.hide_emitters = true;
     p.settings.sampler.type = SamplerType::Stratified;
-    p.settings.spp = spp;
-    for (int b = 0; b < K; ++b) {
-        SceneParams q = p;
-        q.settings.seed = base + uint64_t(b) + 1;
-        films.push_back(std::make_unique<Film>(p.settings.width, p.settings.height));
-        Renderer::render_pass(*scene.with_params(q), *films.back(), 0, spp, 2);
-        ptrs.push_back(films.back().get());
-    }
-    return ImageEstimate::from_batches(ptrs);
-}
-
-ImageEstimate scaled(ImageEstimate e, double s) {
-    for (dvec3& m : e.mean) m *= s;
-    for (dvec3& v : e.var_of_mean) v *= s * s;
-    return e;
+    return render_batches(scene, p, K, spp, base);
 }
 
 void compare(const ImageEstimate& a, const ImageEstimate& b, const std::string& what, int tests) {
-    const double level = sidak_level(kAlpha, tests);
-    BlockTestResult r = block_z_test(a, b, 4, level);
-    dvec3 rel;
-    const double p_whole = whole_image_p(a, b, &rel);
-    const double p_ctl = whole_image_p(scaled(a, 1.03), b);
-    std::printf("  %-22s block %s\n  %-22s whole-image p = %.3g (rel %+.4f %+.4f %+.4f); 3%% brighter: p = %.3g\n",
-                what.c_str(), r.describe().c_str(), what.c_str(), p_whole, rel.x, rel.y, rel.z, p_ctl);
-    EXPECT_TRUE(r.passed(level)) << what << ": " << r.describe();
-    EXPECT_GE(p_whole, level) << what;
-    EXPECT_LT(p_ctl, level) << what << ": the 3% brighter control is not rejected";
+    expect_agreement(a, b, what, tests, true, kAlpha);
 }
 
 std::shared_ptr<const Scene> cornell(int res, bool specular = false) {
@@ -172,77 +148,16 @@ TEST(Bdpt, AgreesWithPathOnTheSpecularBox) {
     compare(bd, pt, "mirror/glass depth 1", 1);
 }
 
-namespace {
-
-// tests/test_ptracer.cpp's icosphere (one subdivision), wound so that the faces look inwards.
-void icosphere(std::vector<vec3>& out, std::vector<uvec3>& f) {
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<dvec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    for (dvec3& p : v) p = glm::normalize(p);
-    f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-         {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-        auto key = std::minmax(a, b);
-        auto it = mid.find(key);
-        if (it != mid.end()) return it->second;
-        v.push_back(glm::normalize(v[a] + v[b]));
-        return mid[key] = uint32_t(v.size() - 1);
-    };
-    std::vector<uvec3> g;
-    for (const uvec3& tri : f) {
-        uint32_t ab = midpoint(tri.x, tri.y), bc = midpoint(tri.y, tri.z), ca = midpoint(tri.z, tri.x);
-        g.insert(g.end(), {{tri.x, ab, ca}, {tri.y, bc, ab}, {tri.z, ca, bc}, {ab, bc, ca}});
-    }
-    f = g;
-    for (uvec3& tri : f)
-        if (glm::dot(glm::cross(v[tri.y] - v[tri.x], v[tri.z] - v[tri.x]), v[tri.x] + v[tri.y] + v[tri.z]) > 0)
-            std::swap(tri.y, tri.z);
-    for (const dvec3& p : v) out.push_back(vec3(p));
-}
-
-}  // namespace
-
 TEST(Bdpt, Furnace) {
-    const vec3 albedo(0.5f, 0.8f, 0.f);
     const std::vector<int> depths = {1, -1};
     const double level = sidak_level(kAlpha, int(depths.size()) * 3);
     for (int depth : depths) {
-        SceneDescription d;
-        d.source = "<furnace>";
-        std::vector<vec3> pos;
-        std::vector<uvec3> f;
-        icosphere(pos, f);
-        d.materials.push_back({"inside", DiffuseBsdf{albedo}, false});
-        d.emitters.push_back({vec3(1.f)});
-        d.add_shape("sphere", pos, {}, f, 0, 0);
-        d.settings.width = d.settings.height = 16;
-        d.settings.max_depth = depth;
-        d.settings.integrator.type = IntegratorType::Bdpt;
-        d.settings.seed = uint64_t(17 + depth);
-        d.camera.to_world = look_at(vec3(0.f), vec3(0.f, 0.f, 1.f), vec3(0.f, 1.f, 0.f));
-        d.camera.fov_deg = 90.f;
-        d.camera.near_clip = 1e-3f;
-        d.camera.far_clip = 10.f;
-        auto sc = build_scene(std::move(d), "brute");
-        Film film(16, 16);
-        Renderer::render_pass(*sc, film, 0, 64, 2);
-        EXPECT_EQ(film.nonfinite_count(), 0u);
-        for (int k = 0; k < 3; ++k) {
-            RunningStats s;
-            for (int y = 0; y < 16; ++y)
-                for (int x = 0; x < 16; ++x) s.add(film.pixel(x, y)[k]);
-            const double a = albedo[k];
-            const double exact = depth < 0 ? 1.0 / (1.0 - a) : (1.0 - std::pow(a, depth + 1)) / (1.0 - a);
-            MeanTest t = z_test(s, exact, 1e-5 * exact);
-            MeanTest ctl = z_test(s, 1.03 * exact, 1e-5 * exact);
-            std::printf("  depth %2d a=%.1f  %s\n  control (3%% off): p = %.3g\n", depth, a, t.describe().c_str(),
-                        ctl.p_value);
-            EXPECT_GE(t.p_value, level) << "depth " << depth << " channel " << k << ": " << t.describe();
-            EXPECT_LT(t.std_error, 0.01 * exact) << "too noisy to reveal a bias";
-            EXPECT_LT(ctl.p_value, level) << "depth " << depth << " channel " << k << ": control not rejected";
-        }
+        FurnaceConfig c;
+        c.integrator = IntegratorType::Bdpt;
+        c.max_depth = depth;
+        c.seed = uint64_t(17 + depth);
+        c.spp = 64;
+        expect_furnace_exact(c, level);
     }
 }
 

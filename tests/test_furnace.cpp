@@ -22,15 +22,17 @@
 #include <map>
 #include <memory>
 #include "render/renderer.h"
+#include "support/agreement.h"
 #include "support/stats.h"
 
 using namespace candela;
 using namespace candela::stats;
+using namespace candela::test;
 
 namespace {
 
 constexpr double kAlpha = 0.01;
-const vec3 kAlbedo(0.5f, 0.8f, 0.f);
+const vec3 kAlbedo = kFurnaceAlbedo;
 const vec3 kLe(1.f, 1.f, 1.f);
 const std::vector<int> kDepths = {0, 1, 2, 5, -1};
 const std::vector<SamplingMode> kModes = {SamplingMode::Light, SamplingMode::Bsdf, SamplingMode::Mis};
@@ -41,73 +43,7 @@ const char* mode_name(SamplingMode m) {
     return m == SamplingMode::Light ? "light" : m == SamplingMode::Bsdf ? "bsdf" : "mis";
 }
 
-double exact(double a, double Le, int depth) {
-    if (depth < 0) return Le / (1.0 - a);
-    return Le * (1.0 - std::pow(a, depth + 1)) / (1.0 - a);
-}
-
-// Unit icosphere with `subdiv` subdivisions, wound so that cross(p1-p0, p2-p0) points INTO the
-// sphere: the diffuse BSDF and the emitter are one-sided and must face the camera inside.
-void icosphere(int subdiv, std::vector<dvec3>& v, std::vector<uvec3>& f) {
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    for (dvec3& p : v) p = glm::normalize(p);
-    f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-         {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-    for (int s = 0; s < subdiv; ++s) {
-        std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-        auto midpoint = [&](uint32_t a, uint32_t b) {
-            auto key = std::minmax(a, b);
-            auto it = mid.find(key);
-            if (it != mid.end()) return it->second;
-            v.push_back(glm::normalize(v[a] + v[b]));
-            return mid[key] = uint32_t(v.size() - 1);
-        };
-        std::vector<uvec3> g;
-        for (const uvec3& tri : f) {
-            uint32_t ab = midpoint(tri.x, tri.y), bc = midpoint(tri.y, tri.z), ca = midpoint(tri.z, tri.x);
-            g.insert(g.end(), {{tri.x, ab, ca}, {tri.y, bc, ab}, {tri.z, ca, bc}, {ab, bc, ca}});
-        }
-        f = g;
-    }
-    for (uvec3& tri : f) {
-        dvec3 a = v[tri.x], b = v[tri.y], c = v[tri.z];
-        if (glm::dot(glm::cross(b - a, c - a), a + b + c) > 0) std::swap(tri.y, tri.z);  // was outward
-    }
-}
-
-struct FurnaceConfig {
-    SamplingMode mode = SamplingMode::Mis;
-    int max_depth = -1;
-    double radius = 1.0;
-    dvec3 center{0.0};
-    int spp = 64;
-    uint64_t seed = 0;
-};
-
-std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c) {
-    auto sc = std::make_unique<SceneDescription>();
-    sc->source = "<furnace>";
-    std::vector<dvec3> v;
-    std::vector<uvec3> f;
-    icosphere(1, v, f);
-    std::vector<vec3> pos;
-    for (const dvec3& p : v) pos.push_back(vec3(c.center + c.radius * p));  // rounded once, to float
-    sc->materials.push_back(Material{"inside", DiffuseBsdf{kAlbedo}, false});
-    sc->emitters.push_back(AreaEmitter{kLe});
-    sc->add_shape("sphere", pos, {}, f, 0, 0);
-    sc->settings.width = sc->settings.height = 16;
-    sc->settings.max_depth = c.max_depth;
-    sc->settings.sampling = c.mode;
-    sc->settings.seed = c.seed;
-    vec3 o(c.center);
-    sc->camera.to_world = look_at(o, o + vec3(0.f, 0.f, float(c.radius)), vec3(0.f, 1.f, 0.f));
-    sc->camera.fov_deg = 90.f;
-    sc->camera.near_clip = float(1e-3 * c.radius);
-    sc->camera.far_clip = float(10.0 * c.radius);
-    return sc;
-}
+double exact(double a, double Le, int depth) { return furnace_exact(a, Le, depth); }
 
 std::shared_ptr<const Scene> furnace_scene(const FurnaceConfig& c) { return build_scene(*furnace_description(c), "brute"); }
 

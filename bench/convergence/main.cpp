@@ -7,8 +7,8 @@
 // time, one line per configuration) and PREFIX.md (per configuration: final error, efficiency
 // 1 / (relMSE x time), and the time to reach a common target error).
 //
-// A configuration is "label:key=value,key=value" with keys sampling (light|bsdf|mis), max_depth,
-// rr_depth, accel (auto|kdtree|hybrid|brute), threads, seed. Biased settings (finite max_depth)
+// A configuration is "label:key=value,key=value" with keys sampling (light|bsdf|mis), integrator
+// (path|bdpt|ptracer|direct), max_depth, rr_depth, accel (auto|kdtree|hybrid|brute), threads, seed. Biased settings (finite max_depth)
 // converge to the wrong image: their error flattens at the bias, and the table marks them.
 //
 // --depth-bias D1..D2 instead measures the energy lost by truncation: for each max depth it renders
@@ -57,6 +57,7 @@ Config parse_config(const std::string& s, const SceneOverrides& base) {
         else if (k == "accel") c.ov.accel = v;
         else if (k == "threads") c.threads = std::stoi(v);
         else if (k == "seed") c.ov.seed = std::stoull(v);
+        else if (k == "integrator") c.ov.integrator = parse_integrator_type(v);
         else throw Error("unknown config key '" + k + "'");
     }
     c.biased = c.ov.max_depth && *c.ov.max_depth >= 0;
@@ -207,7 +208,7 @@ int main(int argc, char** argv) try {
     std::vector<int> depth_bias;
     app.add_option("scene", scene_path, "Scene file (default: the built-in Cornell box)");
     app.add_option("--reference", reference, "Reference image (.exr or .pfm) of the same size");
-    app.add_option("--config,-c", config_strs, "label:key=value,... (sampling, max_depth, rr_depth, accel, threads, seed)");
+    app.add_option("--config,-c", config_strs, "label:key=value,... (sampling, integrator, max_depth, rr_depth, accel, threads, seed)");
     app.add_option("--budget", budget, "Seconds of rendering per configuration");
     app.add_option("--width", width, "Image width (overrides the scene)");
     app.add_option("--height", height, "Image height (overrides the scene)");

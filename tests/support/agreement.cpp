@@ -1,0 +1,130 @@
+#include "support/agreement.h"
+#include <gtest/gtest.h>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include "film/film.h"
+
+namespace candela::test {
+
+using namespace candela::stats;
+
+ImageEstimate render_batches(const Scene& scene, const SceneParams& p, int K, int spp, uint64_t base) {
+    std::vector<std::unique_ptr<Film>> films;
+    std::vector<const Film*> ptrs;
+    for (int b = 0; b < K; ++b) {
+        SceneParams q = p;
+        q.settings.seed = base + uint64_t(b) + 1;
+        q.settings.spp = spp;
+        films.push_back(std::make_unique<Film>(p.settings.width, p.settings.height));
+        Renderer::render_pass(*scene.with_params(q), *films.back(), 0, uint32_t(spp), 2);
+        ptrs.push_back(films.back().get());
+    }
+    return ImageEstimate::from_batches(ptrs);
+}
+
+ImageEstimate scaled(ImageEstimate e, double s) {
+    for (dvec3& m : e.mean) m *= s;
+    for (dvec3& v : e.var_of_mean) v *= s * s;
+    return e;
+}
+
+void expect_agreement(const ImageEstimate& a, const ImageEstimate& b, const std::string& what, int tests, bool control,
+                      double alpha) {
+    const double level = sidak_level(alpha, tests);
+    BlockTestResult r = block_z_test(a, b, 4, level);
+    dvec3 rel;
+    const double p_whole = whole_image_p(a, b, &rel);
+    std::printf("  %-26s block %s\n  %-26s whole-image p = %.3g (rel %+.4f %+.4f %+.4f)\n", what.c_str(),
+                r.describe().c_str(), what.c_str(), p_whole, rel.x, rel.y, rel.z);
+    EXPECT_TRUE(r.passed(level)) << what << ": " << r.describe();
+    EXPECT_GE(p_whole, level) << what;
+    if (control) {
+        const double p_ctl = whole_image_p(scaled(a, 1.03), b);
+        std::printf("  %-26s control (3%% brighter): whole-image p = %.3g\n", what.c_str(), p_ctl);
+        EXPECT_LT(p_ctl, level) << what << ": the 3% brighter control is not rejected";
+    }
+}
+
+void icosphere(int subdiv, std::vector<dvec3>& v, std::vector<glm::uvec3>& f) {
+    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+    v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    for (dvec3& p : v) p = glm::normalize(p);
+    f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+         {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    for (int s = 0; s < subdiv; ++s) {
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+        auto midpoint = [&](uint32_t a, uint32_t b) {
+            auto key = std::minmax(a, b);
+            auto it = mid.find(key);
+            if (it != mid.end()) return it->second;
+            v.push_back(glm::normalize(v[a] + v[b]));
+            return mid[key] = uint32_t(v.size() - 1);
+        };
+        std::vector<glm::uvec3> g;
+        for (const glm::uvec3& tri : f) {
+            uint32_t ab = midpoint(tri.x, tri.y), bc = midpoint(tri.y, tri.z), ca = midpoint(tri.z, tri.x);
+            g.insert(g.end(), {{tri.x, ab, ca}, {tri.y, bc, ab}, {tri.z, ca, bc}, {ab, bc, ca}});
+        }
+        f = g;
+    }
+    for (glm::uvec3& tri : f) {
+        dvec3 a = v[tri.x], b = v[tri.y], c = v[tri.z];
+        if (glm::dot(glm::cross(b - a, c - a), a + b + c) > 0) std::swap(tri.y, tri.z);  // was outward
+    }
+}
+
+double furnace_exact(double a, double Le, int depth) {
+    if (depth < 0) return Le / (1.0 - a);
+    return Le * (1.0 - std::pow(a, depth + 1)) / (1.0 - a);
+}
+
+std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c) {
+    auto sc = std::make_unique<SceneDescription>();
+    sc->source = "<furnace>";
+    std::vector<dvec3> v;
+    std::vector<glm::uvec3> f;
+    icosphere(1, v, f);
+    std::vector<vec3> pos;
+    for (const dvec3& p : v) pos.push_back(vec3(c.center + c.radius * p));  // rounded once, to float
+    sc->materials.push_back(Material{"inside", DiffuseBsdf{kFurnaceAlbedo}, false});
+    sc->emitters.push_back(AreaEmitter{vec3(1.f)});
+    sc->add_shape("sphere", pos, {}, f, 0, 0);
+    sc->settings.width = sc->settings.height = c.res;
+    sc->settings.max_depth = c.max_depth;
+    sc->settings.sampling = c.mode;
+    sc->settings.integrator.type = c.integrator;
+    sc->settings.seed = c.seed;
+    vec3 o(c.center);
+    sc->camera.to_world = look_at(o, o + vec3(0.f, 0.f, float(c.radius)), vec3(0.f, 1.f, 0.f));
+    sc->camera.fov_deg = 90.f;
+    sc->camera.near_clip = float(1e-3 * c.radius);
+    sc->camera.far_clip = float(10.0 * c.radius);
+    return sc;
+}
+
+dvec3 expect_furnace_exact(const FurnaceConfig& c, double level) {
+    auto sc = build_scene(std::move(*furnace_description(c)), "brute");
+    Film film(c.res, c.res);
+    Renderer::render_pass(*sc, film, 0, uint32_t(c.spp), 2);
+    EXPECT_EQ(film.nonfinite_count(), 0u);
+    dvec3 z(0.0);
+    for (int k = 0; k < 3; ++k) {
+        RunningStats s;
+        for (int y = 0; y < c.res; ++y)
+            for (int x = 0; x < c.res; ++x) s.add(film.pixel(x, y)[k]);
+        const double exact = furnace_exact(kFurnaceAlbedo[k], 1.0, c.max_depth);
+        MeanTest t = z_test(s, exact, 1e-5 * exact);
+        MeanTest ctl = z_test(s, 1.03 * exact, 1e-5 * exact);
+        std::printf("  depth %2d a=%.1f  %s\n  control (3%% off): p = %.3g\n", c.max_depth, kFurnaceAlbedo[k],
+                    t.describe().c_str(), ctl.p_value);
+        EXPECT_GE(t.p_value, level) << "depth " << c.max_depth << " channel " << k << ": " << t.describe();
+        EXPECT_LT(t.std_error, 0.01 * exact) << "too noisy to reveal a bias";
+        EXPECT_LT(ctl.p_value, level) << "depth " << c.max_depth << " channel " << k << ": control not rejected";
+        z[k] = t.statistic;
+    }
+    return z;
+}
+
+}  // namespace candela::test

@@ -1,0 +1,56 @@
+#pragma once
+// Shared by the integrator agreement tests (tests/test_bdpt.cpp, test_ptracer.cpp,
+// test_furnace.cpp): batch rendering with independent seeds, the block and whole-image z-tests of
+// one integrator against another with the 3% brighter control, and the analytic furnace scene.
+#include <memory>
+#include <string>
+#include <vector>
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "support/stats.h"
+
+namespace candela::test {
+
+// K films of `spp` samples each of `scene` with the parameters `p` (integrator included), seeds
+// base + 1 .. base + K, 2 threads; the estimate from the spread of the batch means.
+stats::ImageEstimate render_batches(const Scene& scene, const SceneParams& p, int K, int spp, uint64_t base);
+
+// Every mean scaled by s (variances by s^2): the controls.
+stats::ImageEstimate scaled(stats::ImageEstimate e, double s);
+
+// a against b: block z-test (4 x 4 blocks) and whole-image z-test at alpha Sidak-corrected over
+// `tests`, printed; with `control`, the image a 3% brighter must be rejected by the whole-image test.
+void expect_agreement(const stats::ImageEstimate& a, const stats::ImageEstimate& b, const std::string& what, int tests,
+                      bool control, double alpha = 0.01);
+
+// ---- the furnace ----------------------------------------------------------------------------
+// The camera inside a closed sphere whose inside is diffuse with albedo kFurnaceAlbedo and emits
+// Le = 1: L = Le (1 - a^(d+1)) / (1 - a) with at most d scattering events, Le / (1 - a) unbounded.
+inline const glm::vec3 kFurnaceAlbedo(0.5f, 0.8f, 0.f);
+
+// Unit icosphere with `subdiv` subdivisions, wound so that cross(p1-p0, p2-p0) points INTO the
+// sphere: the diffuse BSDF and the emitter are one-sided and must face the camera inside.
+void icosphere(int subdiv, std::vector<glm::dvec3>& v, std::vector<glm::uvec3>& f);
+
+double furnace_exact(double a, double Le, int depth);
+
+struct FurnaceConfig {
+    IntegratorType integrator = IntegratorType::Path;
+    SamplingMode mode = SamplingMode::Mis;
+    int max_depth = -1;
+    double radius = 1.0;
+    glm::dvec3 center{0.0};
+    int spp = 64;
+    uint64_t seed = 0;
+    int res = 16;
+};
+
+// The furnace (one subdivision, 16 x 16 by default, a 90 degree camera at the centre looking +z).
+std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c);
+
+// Renders the furnace (c.spp samples, 2 threads) and z-tests the mean over the pixel means of each
+// channel against the exact value at `level`, with the 3%-off control rejected at the same level
+// and the standard error below 1% of the value; printed. Returns the z statistics per channel.
+glm::dvec3 expect_furnace_exact(const FurnaceConfig& c, double level);
+
+}  // namespace candela::test

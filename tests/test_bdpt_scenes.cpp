@@ -1,0 +1,116 @@
+// BDPT and the light tracer against the path tracer on the repository's scenes (issue 15, docs/bdpt.md
+// "Tests"): the Veach MIS scene, the caustics scene, the mirror/glass Cornell box, an envmap and a
+// thin-lens camera. Reduced resolutions; 8 batches per integrator with independent seeds; block
+// z-test (4 x 4 blocks) and whole-image z-test, Sidak-corrected over the depths of one test, with
+// the 3% brighter control where the budget gives the power for it (otherwise the comment says
+// which shared control covers the estimator).
+#include <gtest/gtest.h>
+#include "render/renderer.h"
+#include "scene/loaders.h"
+#include "support/agreement.h"
+#include "support/stats.h"
+
+using namespace candela;
+using namespace candela::stats;
+using namespace candela::test;
+
+namespace {
+
+constexpr double kAlpha = 0.01;
+
+std::shared_ptr<const Scene> load(const std::string& rel, Defines defines) {
+    return build_scene(load_scene(std::string(CANDELA_SOURCE_DIR) + "/" + rel, defines));
+}
+
+// One comparison of `a` against `b` (integrator type, spp), both on `scene` at max depth `depth`.
+// hide_emitters in both and the stratified sampler: the lamps seen directly cover a few pixels
+// partly, which otherwise dominates the whole image's noise alike in every integrator.
+void agree(const Scene& scene, int depth, IntegratorType a, int spp_a, IntegratorType b, int spp_b, uint64_t seed,
+           const std::string& what, int tests, bool control) {
+    SceneParams p = scene.params();
+    p.settings.max_depth = depth;
+    p.settings.integrator.hide_emitters = true;
+    p.settings.sampler.type = SamplerType::Stratified;
+    p.settings.integrator.type = a;
+    ImageEstimate ea = render_batches(scene, p, 8, spp_a, seed);
+    p.settings.integrator.type = b;
+    ImageEstimate eb = render_batches(scene, p, 8, spp_b, seed + 100);
+    expect_agreement(ea, eb, what, tests, control, kAlpha);
+}
+
+std::string depth_name(int d) { return d < 0 ? "unbounded" : "depth " + std::to_string(d); }
+
+}  // namespace
+
+// The Veach MIS scene (glossy plates of four roughnesses, four spherical lights), 32 x 22: at
+// depth 1 what the path tracer's MIS is about; deeper, the plates' interreflections with the floor.
+// The smallest lamp (radiance 800) is dimmed 50x here: its highlights on the plates are sub-pixel
+// at this size, and their pixel coverage alone made the whole image's mean 5-15% noisy at this
+// budget in both integrators alike (measured). Dimmed it is still 2-5%: no 3% control here; the
+// Cornell box tests' controls (same comparison, same estimator) are rejected at every depth.
+std::shared_ptr<const Scene> veach() {
+    auto sc = load("scenes/veach-mis/scene.xml", {{"width", "32"}, {"height", "22"}});
+    SceneParams p = sc->params();
+    for (AreaEmitter& e : p.emitters)
+        if (e.radiance.x > 100.f) e.radiance *= 0.02f;
+    return sc->with_params(p);
+}
+
+TEST(Bdpt, AgreesWithPathOnTheVeachMisScene) {
+    auto sc = veach();
+    const std::vector<int> depths = {1, 2, 5, -1};
+    for (int d : depths)
+        agree(*sc, d, IntegratorType::Bdpt, 32, IntegratorType::Path, 64, 1000 + 10 * uint64_t(d + 1),
+              "veach-mis " + depth_name(d), int(depths.size()), false);
+}
+
+// The caustics scene (a glass sphere and a diamond on a diffuse floor under a small lamp), 24 x 18,
+// depth 1. Deeper, the caustics (lamp -> glass -> floor) are rare, bright events for the path
+// tracer (its floor points must hit the small lamp through the glass by BSDF sampling): at depth
+// 2, 5 and unbounded the blocks under the sphere differed from BDPT's by z = 4-5 (up to 20% of the
+// blocks failing), the variance estimate of 8 batches being unreliable there; at 16k spp (path)
+// against 2k spp (BDPT) those blocks still differ by up to 2x either way. The path tracer is no
+// reference for them at a test's budget (docs/bdpt.md, "Tests").
+// No 3% control: the lamp's sub-pixel reflections in the sphere and the diamond make the whole
+// image's mean 1.5-5% noisy in both integrators alike; the comparison code and the estimator are
+// the Cornell box tests', whose 3% controls are rejected at every depth (p <= 1.4e-10).
+TEST(Bdpt, AgreesWithPathOnTheCausticsScene) {
+    auto sc = load("scenes/caustics/scene.xml", {{"width", "24"}, {"height", "18"}});
+    const std::vector<int> depths = {1};
+    for (int d : depths)
+        agree(*sc, d, IntegratorType::Bdpt, 32, IntegratorType::Path, 128, 1200 + 10 * uint64_t(d + 1),
+              "caustics " + depth_name(d), int(depths.size()), false);
+}
+
+// The mirror/glass Cornell box of scenes/ (Bdpt.AgreesWithPathOnTheSpecularBox has depth 1).
+TEST(Bdpt, AgreesWithPathOnTheMirrorGlassBox) {
+    auto sc = load("scenes/cornell-materials/mirror-glass.xml", {{"res", "16"}});
+    const std::vector<int> depths = {2, -1};
+    for (int d : depths)
+        agree(*sc, d, IntegratorType::Bdpt, 64, IntegratorType::Path, 192, 1400 + 10 * uint64_t(d + 1),
+              "mirror-glass " + depth_name(d), int(depths.size()), true);
+}
+
+// An envmap (an infinite light with a small bright sun): escaped camera paths (s = 0) and light
+// paths leaving the scene's bounding disk.
+TEST(Bdpt, AgreesWithPathUnderAnEnvmap) {
+    auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/envmap.xml", {{"res", "16"}}));
+    const std::vector<int> depths = {2, -1};
+    for (int d : depths)
+        agree(*sc, d, IntegratorType::Bdpt, 64, IntegratorType::Path, 128, 1500 + 10 * uint64_t(d + 1),
+              "envmap " + depth_name(d), int(depths.size()), true);
+}
+
+// The thin-lens camera (a crop window of its film, focused on the red cube): the lens is sampled by
+// the camera subpath and by the t = 1 connections.
+TEST(Bdpt, AgreesWithPathThroughAThinLens) {
+    auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/cameras/thinlens.xml", {}));
+    const std::vector<int> depths = {2};
+    for (int d : depths)
+        agree(*sc, d, IntegratorType::Bdpt, 16, IntegratorType::Path, 32, 1600, "thin lens " + depth_name(d), 1, true);
+}
+
+TEST(Ptracer, AgreesWithPathThroughAThinLens) {
+    auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/cameras/thinlens.xml", {}));
+    agree(*sc, 2, IntegratorType::Ptracer, 64, IntegratorType::Path, 32, 1700, "thin lens depth 2", 1, true);
+}
