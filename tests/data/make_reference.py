@@ -22,7 +22,7 @@ TOOLS = os.path.normpath(os.path.join(HERE, "..", "..", "..", "shared", "tools")
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("scene")
-    ap.add_argument("--res", type=int, default=64)
+    ap.add_argument("--res", type=int, default=64, help="the scene's $res (0: not passed, for scenes sized by -D width=, height=)")
     ap.add_argument("--batches", type=int, default=16)
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--variant", default="llvm_ad_rgb")
@@ -36,7 +36,7 @@ def main():
     for k in range(a.batches):
         path = "%s_batch%d.exr" % (a.out, k)
         cmd = [sys.executable, os.path.join(TOOLS, "mitsuba_render.py"), a.scene, "--variant", a.variant,
-               "--spp", str(a.spp), "--seed", str(k + 1), "--out", path, "-D", "res=%d" % a.res]
+               "--spp", str(a.spp), "--seed", str(k + 1), "--out", path] + (["-D", "res=%d" % a.res] if a.res else [])
         for d in a.defines:
             cmd += ["-D", d]
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
