@@ -535,7 +535,7 @@ TEST(SceneXml, EveryShippedSceneLoads) {
     const char* files[] = {"scenes/cornell-box/scene.xml", "scenes/veach-mis/scene.xml",
                            "scenes/cornell-materials/mirror-glass.xml", "scenes/cornell-materials/rough.xml",
                            "scenes/cornell-materials/glossy-glass.xml", "scenes/caustics/scene.xml",
-                           "scenes/lamp/scene.xml"};
+                           "scenes/lamp/scene.xml", "scenes/door-ajar/scene.xml"};
     for (const char* f : files) {
         SceneDescription s = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/" + f, {{"res", "16"}, {"width", "16"}, {"height", "16"}});
         EXPECT_NO_THROW(build_scene(s)) << f;
