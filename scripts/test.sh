@@ -10,7 +10,7 @@
 #               Debug run is for assertions and code that -O3 could hide. CANDELA_DEBUG_EXCLUDE=REGEX
 #               replaces the regex (an empty value runs everything). See docs/reliability.md.
 #   --sanitize  the ASan+UBSan build in build-asan/ (MPI off: Open MPI's own leaks are not ours),
-#               every test but the 19 longest statistical and brute-force ones (10-40 s each in
+#               every test but the 22 longest statistical and brute-force ones (10-40 s each in
 #               Release, 5-7x that instrumented), each repeating with more samples code that a
 #               lighter test of the same family runs instrumented, and the 14 power controls
 #               (list and reasons in docs/reliability.md). CANDELA_ASAN_EXCLUDE=REGEX replaces the list (an empty
@@ -33,7 +33,7 @@ case "$mode" in
   --debug)
     dir=$(bash scripts/build.sh --debug | tail -n 1)
     cd "$dir"
-    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)|Filters\.EachFilterMatchesMitsuba|BsdfWeights\.RoughPlasticWeightIsBounded|SceneSplit\.TheCoatCacheKeepsOnlyTablesInUse|BsdfFurnace|MeshFormatsRender|Microfacet\.VisibleNormal|Emitters\.MitsubaAgreement|Instancing\.(MemoryGrows|HitsAgree|MitsubaAgreement)|BsdfWrappers\.(BlendSampling|MitsubaAgreement)|BsdfMitsuba\.[A-Za-z]*Render|PrincipledMitsuba\.RenderAgreement|AnalyticShapes\.MitsubaAgreement|Texture\.MitsubaAgreement|Envmap\.(ImageMatchesMitsuba|SampleLiMatchesPdfLi)|Direct\.(ExactIrradiance|MatchesMitsuba)|Adaptive\.CornellImage|Bdpt\.(AgreesWith|Furnace|Unweighted)|Mlt\.(AgreesWith|BootstrapMatches|MmltAgreesWith|MmltBootstrapMatches)|Ptracer\.AgreesWithPathThroughAThinLens)\.?'
+    heavy='^(BsdfChi2|PrincipledChi2|DiffuseBsdf\.ChiSquare|Warp\.ChiSquare|KdTree|AccelDegenerate|ImageCornell|Furnace|BsdfScenes|Mis|Stability|SelfIntersection\.BunnyNeverHitsItself|PrincipledMitsuba\.AlbedoAgrees|Cameras\.[A-Za-z]*MatchesMitsubaReference|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox|AgreesWithMitsubaPtracer)|Filters\.EachFilterMatchesMitsuba|BsdfWeights\.RoughPlasticWeightIsBounded|SceneSplit\.TheCoatCacheKeepsOnlyTablesInUse|BsdfFurnace|MeshFormatsRender|Microfacet\.VisibleNormal|Emitters\.MitsubaAgreement|Instancing\.(MemoryGrows|HitsAgree|MitsubaAgreement)|BsdfWrappers\.(BlendSampling|MitsubaAgreement)|BsdfMitsuba\.[A-Za-z]*Render|PrincipledMitsuba\.RenderAgreement|AnalyticShapes\.MitsubaAgreement|Texture\.MitsubaAgreement|Envmap\.(ImageMatchesMitsuba|SampleLiMatchesPdfLi)|Direct\.(ExactIrradiance|MatchesMitsuba)|Adaptive\.CornellImage|Bdpt\.(AgreesWith|Furnace|Unweighted)|Mlt\.(AgreesWith|BootstrapMatches|MmltAgreesWith|MmltBootstrapMatches)|Ptracer\.AgreesWithPathThroughAThinLens)\.?'
     exclude=${CANDELA_DEBUG_EXCLUDE-$heavy}
     ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${exclude:+-E "$exclude"}
     ;;
@@ -48,7 +48,7 @@ case "$mode" in
     # LeakSanitizer runs, so no suppression can name it: it runs with leak checking off (memory
     # errors and UB are still fatal).
     viewer='^ViewerWindow\.'
-    long='^(Mis\.|BsdfChi2\.SamplingMatchesPdf$|PrincipledChi2\.SamplingMatchesPdf$|KdTree\.(DragonMatchesBruteForce|BunnyMatchesBruteForce|CoherentOriginsMatchBruteForce)$|Filters\.EachFilterMatchesMitsuba$|BsdfWeights\.RoughPlasticWeightIsBounded$|PrincipledMitsuba\.AlbedoAgrees$|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox)$|Bdpt\.AgreesWithMitsubaOnTheCausticsScene$|Furnace\.EverySampler$|ImageCornell\.EverySamplerMatchesMitsubaReference$|Cameras\.(Perspective|Orthographic)MatchesMitsubaReference$|Mlt\.(AgreesWithPathOnTheMirrorGlassBox|MmltAgreesWithPathOnTheCornellBox)$)'
+    long='^(Mis\.|BsdfChi2\.SamplingMatchesPdf$|PrincipledChi2\.SamplingMatchesPdf$|KdTree\.(DragonMatchesBruteForce|BunnyMatchesBruteForce|CoherentOriginsMatchBruteForce)$|Filters\.EachFilterMatchesMitsuba$|BsdfWeights\.RoughPlasticWeightIsBounded$|PrincipledMitsuba\.AlbedoAgrees$|Ptracer\.(Furnace|AgreesWithPathOnTheCornellBox|AgreesWithMitsubaPtracerOnTheCausticsScene|AgreesWithMitsubaPtracerOnTheMirrorGlassBox)$|Bdpt\.AgreesWithMitsubaOnTheCausticsScene$|Furnace\.EverySampler$|ImageCornell\.EverySamplerMatchesMitsubaReference$|Cameras\.(Perspective|Orthographic)MatchesMitsubaReference$|Mlt\.(AgreesWithPathOnTheMirrorGlassBox|MmltAgreesWithPathOnTheCornellBox|MmltAgreesWithBdptOnTheMirrorGlassBox)$)'
     # The power controls (the same agreement render with a deliberately wrong parameter, which
     # must fail) prove a statistic's power, not memory safety: they run in Release only.
     controls='^(AnalyticShapes\.MitsubaAgreementDetects|BsdfMitsuba\.[A-Za-z]*Detects|BsdfScenes\.LosslessFurnaceRejects|BsdfWrappers\.MitsubaAgreementDetects|Filters\.BoxImageIsRejected|Furnace\.DetectsBias|ImageCornell\.[A-Za-z]*Detects|Instancing\.MitsubaAgreementDetects|MeshFormatsRender\.ControlsFail|PrincipledMitsuba\.RenderAgreementDetects|Stability\.ScaleComparisonDetects|Texture\.MitsubaAgreementDetects)'

@@ -3,7 +3,8 @@
 // thin-lens camera. Reduced resolutions; 8 batches per integrator with independent seeds; block
 // z-test (4 x 4 blocks) and whole-image z-test, Sidak-corrected over the depths of one test, with
 // the 3% brighter control where the budget gives the power for it (otherwise the comment says
-// which shared control covers the estimator).
+// which shared control covers the estimator). Past what the path tracer can referee: BDPT and the
+// light tracer against committed Mitsuba 3 references (its path and ptracer integrators).
 #include <gtest/gtest.h>
 #include "render/renderer.h"
 #include "scene/loaders.h"
@@ -140,4 +141,50 @@ TEST(Bdpt, AgreesWithPathThroughAThinLens) {
 TEST(Ptracer, AgreesWithPathThroughAThinLens) {
     auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/cameras/thinlens.xml", {}));
     agree(*sc, 2, IntegratorType::Ptracer, 64, IntegratorType::Path, 32, 1700, "thin lens depth 2", 1, true);
+}
+
+// ---- the light tracer against Mitsuba 3's ptracer ----------------------------------------------
+// A pure light tracer cannot see what the camera sees through a delta surface (camera -> glass or
+// mirror -> lamp has no vertex it can connect to the camera), so on the caustics and mirror/glass
+// scenes its expected image is not the path tracer's: the reference is Mitsuba 3's `ptracer` on
+// the same XML, which has the same blind spot. tests/data/ptracer_<scene>_{d2,inf}_{mean,var}.exr:
+// 16 batches x 4096 spp of Mitsuba 3.9.1 llvm_ad_rgb, made by
+//   $PY tests/data/make_reference.py SCENE --integrator ptracer --batches 16 --spp 4096
+//       --out tests/data/ptracer_<scene>_d2 -D max_depth=3   (and max_depth=-1 for _inf)
+// with --res 0 -D width=24 -D height=18 (caustics) and --res 16 (mirror-glass). candela's depth 2 is
+// Mitsuba's max_depth 3. Both as the XML says: the independent sampler, emitters visible (Mitsuba's
+// ptracer splats them by sampling a point on an emitter and connecting it to the camera, as
+// candela's does), Russian roulette from rr_depth (5). The emitter choice differs (Mitsuba picks
+// emitters uniformly, candela by power): the same expectation, other noise. 16 batches x 128 spp,
+// depth 2 and unbounded, Sidak over the two; max |z| over three seed bases (+0, +1000, +2000),
+// depth 2 / unbounded: caustics 2.0 / 2.7, 2.3 / 2.1, 1.9 / 2.3, control (3% brighter) p <= 1e-22;
+// mirror/glass 2.9 / 2.1, 2.5 / 1.5, 1.9 / 1.8, control p <= 1e-148. At 64 spp per batch
+// (mirror/glass 24 x 24) one seed base gave a block at z = 4.0 (family p 0.006, at the level's
+// edge): the rare bright caustic paths again, too few per batch for the spread of the batch means.
+// The Veach MIS scene is not tested (docs/bdpt.md, "Tests": at 16 x 512 spp its whole-image mean
+// is still 1.5% noisy, the 3% control not rejected).
+namespace {
+
+void ptracer_vs_mitsuba(const std::string& rel, Defines defines, const std::string& ref, int width, uint64_t base) {
+    auto sc = load(rel, defines);
+    const std::vector<std::pair<int, std::string>> depths = {{2, "d2"}, {-1, "inf"}};
+    for (const auto& [d, name] : depths) {
+        SceneParams p = sc->params();
+        p.settings.max_depth = d;
+        p.settings.integrator.type = IntegratorType::Ptracer;
+        const ImageEstimate mi = ImageEstimate::from_reference_files(std::string(CANDELA_TEST_DATA) + "/" + ref + "_" + name);
+        ASSERT_EQ(mi.width, width);
+        ImageEstimate e = render_batches(*sc, p, 16, 128, base + 10 * uint64_t(d + 1));
+        expect_agreement(e, mi, ref + " " + depth_name(d), int(depths.size()), true);
+    }
+}
+
+}  // namespace
+
+TEST(Ptracer, AgreesWithMitsubaPtracerOnTheCausticsScene) {
+    ptracer_vs_mitsuba("scenes/caustics/scene.xml", {{"width", "24"}, {"height", "18"}}, "ptracer_caustics24", 24, 1800);
+}
+
+TEST(Ptracer, AgreesWithMitsubaPtracerOnTheMirrorGlassBox) {
+    ptracer_vs_mitsuba("scenes/cornell-materials/mirror-glass.xml", {{"res", "16"}}, "ptracer_mirrorglass16", 16, 2000);
 }
