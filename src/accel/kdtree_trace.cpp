@@ -47,6 +47,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 using D4 = hn::CappedTag<float, 4>;
 using V4 = hn::Vec<D4>;
 using M4 = hn::Mask<D4>;
+using D1 = hn::CappedTag<float, 1>;  // one float, for branch-free selects in the walk from the origin
+using V1 = hn::Vec<D1>;
 constexpr int kStep = int(hn::MaxLanes(D4()));
 static_assert(4 % kStep == 0, "a block is a whole number of vectors");
 
@@ -227,8 +229,11 @@ bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB
         // test of the general step below), and the other child is pushed when the ray reaches the
         // plane inside the segment. The general step visits the same nodes with the same
         // intervals, but its branches on tp mispredict here, so this walk (half of a bounce or
-        // shadow ray's node visits) is written without branches on tp: selects that compile to
-        // minss/maxss and flag arithmetic (docs/accel.md has the measurements).
+        // shadow ray's node visits) is written without branches on tp: flag arithmetic, a scalar
+        // min (minss) and two one-lane vector selects (docs/accel.md has the measurements).
+        const D1 d1;
+        const V1 inf1 = hn::Set(d1, kInfinity), zero1 = hn::Zero(d1);
+        const V1 up1 = hn::Set(d1, kWidenUp), down1 = hn::Set(d1, kWidenDown);
         while (!node->leaf()) {
             KD_COUNT(nodes, 1);
             const int a = node->axis();
@@ -238,16 +243,21 @@ bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB
             const Node* below = nodes + node->children();
             // Pushed unless the plane is behind (tp <= 0) or beyond the segment; a NaN tp (the
             // ray lies in the plane) fails both comparisons and so pushes, over the whole segment:
-            // `x > 0 ? x : 0` (maxss x, 0) gives its second operand, 0, for a NaN x. The
-            // segment's end is a running minimum over the planes ahead (min(t1, tp) when tp > 0,
-            // which leaves t1 alone where nothing was pushed, NaN included), so its update does
-            // not wait for the push decision.
+            // `x > 0 ? x : 0` (what maxss x, 0 computes) gives 0 for a NaN x. The segment's end
+            // is a running minimum over the planes ahead (min(t1, tp) when tp > 0, which leaves
+            // t1 alone where nothing was pushed, NaN included), so its update does not wait for
+            // the push decision.
+            // The two selects on tp are one-lane vector selects: GCC 12 compiles a scalar
+            // `tp > 0 ? tp * up : inf` to a branch on tp however it is written (the product sinks
+            // into its arm), and that branch mispredicts here (bounce rays 10% slower); without
+            // SSE4.1 it branches on `x > 0 ? x : 0` too. IfThenElse, not Max: Max's result for a
+            // NaN differs between targets (NEON returns the NaN).
             const float tp = (split - oa) * r.inv_d[a];
-            const float tp_down = tp * kWidenDown;
-            const float tp_ahead = tp > 0.f ? tp * kWidenUp : kInfinity;
+            const V1 vtp = hn::Set(d1, tp), tp_down = hn::Mul(vtp, down1);
+            const float tp_ahead = hn::GetLane(hn::IfThenElse(hn::Gt(vtp, zero1), hn::Mul(vtp, up1), inf1));
             const int push = int(!(tp <= 0.f)) & int(!(tp > t1 * kWidenUp));
             st_node[sp] = below + (1 - above);
-            st_t0[sp] = tp_down > 0.f ? tp_down : 0.f;
+            st_t0[sp] = hn::GetLane(hn::IfThenElse(hn::Gt(tp_down, zero1), tp_down, zero1));
             st_t1[sp] = t1;
             sp += push & int(node->empty_child(1 - above) ^ 1u);
             t1 = t1 < tp_ahead ? t1 : tp_ahead;
