@@ -1,12 +1,12 @@
 // K-d tree traversal (KdTree::intersect and KdTree::occluded) with its 4-wide triangle test.
 //
 // The SIMD is Google Highway, compiled once per instruction set that the target architecture
-// offers (foreach_target: SSSE3, SSE4, AVX2, AVX-512 on x86; NEON and SVE on aarch64; EMU128,
-// plain C++, everywhere) and chosen at run time for the CPU, once per ray (HWY_DYNAMIC_DISPATCH:
-// one indirect call, like the Accel's virtual one). The vectors are 4 lanes of float whatever the
-// target: a leaf block holds 4 triangles (KdTree::TriBlock), so wider vectors would have nothing
-// to fill their other lanes with; AVX2 and AVX-512 still give the VEX/EVEX encodings (three-operand
-// forms, mask registers). docs/accel.md has the measurements.
+// offers (foreach_target: SSSE3, SSE4, AVX2 on x86; NEON and SVE on aarch64; a scalar fallback
+// everywhere) and chosen at run time for the CPU, once per ray (HWY_DYNAMIC_DISPATCH: one indirect
+// call, like the Accel's virtual one). Runtime dispatch, although the kernel is 128 bits: static
+// dispatch at the x86-64 baseline would get Highway 1.0.3's scalar fallback. The vectors are 4
+// lanes of float whatever the target: a leaf block holds 4 triangles (KdTree::TriBlock), so wider
+// vectors would have nothing to fill their other lanes with. docs/accel.md has the measurements.
 //
 // Exactness: each lane of triangle_hits4 is intersect_triangle() (geometry/triangle.h) on that
 // triangle, bit for bit. That holds only without fused multiply-add: the AVX2, AVX-512, NEON and
@@ -19,6 +19,13 @@
 #include <cstdint>
 #include "core/math.h"
 #include "geometry/triangle.h"
+
+// No AVX-512 code: with 4 lanes it only changes the encoding, and it measured 0.83x on the Cornell
+// box's camera rays (any hit) where AVX2 and SSE4 match the raw-SSE version (docs/accel.md). The
+// dispatch then takes AVX2 on an AVX-512 CPU (the chosen target is masked per translation unit).
+#ifndef HWY_DISABLED_TARGETS
+#define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL)
+#endif
 
 // foreach_target re-includes this file once per target with HWY_TARGET set; everything between
 // HWY_BEFORE_NAMESPACE and HWY_AFTER_NAMESPACE is compiled for each of them.
