@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the tests under ctest.
-# Usage: bash scripts/test.sh [--debug | --sanitize | --tsan]
+# Usage: bash scripts/test.sh [--debug | --sanitize | --tsan | --fuzz]
 #   (none)      the Release build in build/ with MPI (Open MPI is installed for it), every test,
 #               the MPI ones (Mpi.*: mpirun -np 1, 2, 3 on this machine) included
 #   --debug     the Debug build (-O0, assertions on, MPI off) in build-debug/, every test but the heavy
@@ -20,6 +20,9 @@
 #               OMP_THREAD_LIMIT=1 and tests/tsan.supp: GCC's libgomp is not instrumented, so TSan
 #               cannot see its barriers; one OpenMP thread per pass leaves TSan the session's own
 #               threads (worker and front end) to check. See docs/reliability.md.
+#   --fuzz      the libFuzzer targets (tests/fuzz/, clang-14, ASan+UBSan) built in build-fuzz/ and
+#               each run for CANDELA_FUZZ_SECONDS (default 5) by scripts/fuzz.sh: a check that they
+#               compile and run, not a fuzzing campaign (that is `bash scripts/fuzz.sh 300`)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 mode=${1:-}
@@ -65,6 +68,9 @@ case "$mode" in
     cmake --build build-tsan -j"$(nproc)" --target candela_tests >&2
     export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp"
     OMP_THREAD_LIMIT=1 build-tsan/tests/candela_tests --gtest_filter='Session.*:ViewerFrontEnd.*:SceneSplit.*'
+    ;;
+  --fuzz)
+    bash scripts/fuzz.sh "${CANDELA_FUZZ_SECONDS:-5}"
     ;;
   *) echo "test.sh: unknown option '$mode'" >&2; exit 2 ;;
 esac

@@ -7,11 +7,11 @@
 // splits it into the children's lists without re-sorting (only the few straddling triangles are
 // clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
 //
-// Traversal: 8-byte nodes, a fixed-size stack, template <bool Shadow> for the any-hit variant.
-// Leaves hold their triangles' vertices in blocks of four, laid out for the 4-wide filter (a copy
-// per leaf reference). Every triangle test
-// is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the same t,
-// bit for bit, as the brute-force oracle.
+// Traversal (kdtree_trace.cpp): 8-byte nodes, a fixed-size stack, a template <bool Shadow> for the
+// any-hit variant, compiled per SIMD target (Highway) and chosen at run time. Leaves hold their
+// triangles' vertices in blocks of four, laid out for the 4-wide filter (a copy per leaf
+// reference). Every triangle test is the watertight intersect_triangle() on the mesh's own vertex
+// values, so a hit has the same t, bit for bit, as the brute-force oracle.
 #include <cstdint>
 #include <vector>
 #include "accel/accel.h"
@@ -23,7 +23,7 @@ namespace candela {
 struct KdBuildOptions {
     // Surface area heuristic: cost = traversal + intersection * (P_left N_left + P_right N_right),
     // times (1 - empty_bonus) when one side is empty. Units: one triangle test = intersection.
-    // A triangle costs a third of a node step: leaves are tested four at a time by the SSE filter,
+    // A triangle costs a third of a node step: leaves are tested four at a time by the SIMD filter,
     // while a node step is a dependent load and a branch (sweep in docs/accel.md).
     float traversal_cost = 1.f;
     float intersection_cost = 0.3f;
@@ -102,8 +102,6 @@ public:
     static_assert(sizeof(TriBlock) == 160, "a block is 4 triangles");
 
 private:
-    template <bool Shadow>
-    bool trace(Ray& ray, Hit* hit) const;
     void interrupted_build();
 
     std::vector<Node> nodes_;
