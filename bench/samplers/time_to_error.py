@@ -25,6 +25,10 @@ is kept), so that a load that changed during the run does not favour one rendere
 complete set of N in candela (sample_count = N); Mitsuba renders in passes of 64 (the tool's
 bound on llvm memory; 49 for orthogonal), each pass its own complete set, as its renders would.
 Wall times on a shared machine vary by +-30%: read the time columns with that in mind.
+--clamp C measures the error of both images clipped to [0, C] per channel (C = 1: the error a
+display shows, where everything above white is white). On scenes whose error is dominated by
+rare very bright samples (the Veach MIS plates, caustics) the unclipped RMSE of a few seeds does
+not fall steadily with the samples, so no time to an error can be read from it; clipped, it can.
 """
 import argparse, json, math, os, re, sys
 import numpy as np
@@ -89,6 +93,13 @@ def mitsuba_render(args, sampler, seed, spp):
     return np.asarray(img, dtype=np.float64)[..., :3], float(info["render_s"])
 
 
+def sq_err(args, img, ref):
+    """Mean squared error over pixels and channels, both images clipped to [0, --clamp] if set."""
+    if args.clamp > 0:
+        img, ref = np.clip(img, 0, args.clamp), np.clip(ref, 0, args.clamp)
+    return np.mean((img - ref) ** 2)
+
+
 def curve(args, renderer, sampler, ref, ref_mse):
     """[(spp, RMSE)] over the levels, ref_mse taken out, and the time per spp (s, whole image)."""
     pts, per_spp = [], math.inf
@@ -100,7 +111,7 @@ def curve(args, renderer, sampler, ref, ref_mse):
                 img, t = candela_render(args, sampler, seed, n, f"{args.cache}/c_{sampler}_{n}_{seed}.pfm")
             else:
                 img, t = mitsuba_render(args, sampler, seed, n)
-            mse.append(np.mean((img - ref) ** 2))
+            mse.append(sq_err(args, img, ref))
             per_spp = min(per_spp, t / n)
         pts.append((n, math.sqrt(max(np.mean(mse) - ref_mse, 1e-30))))
         print(f"  {renderer} {sampler} {n} spp: RMSE {pts[-1][1]:.5f}", file=sys.stderr, flush=True)
@@ -131,6 +142,7 @@ def main():
     ap.add_argument("--candela-samplers", default=",".join(CANDELA))
     ap.add_argument("--mitsuba-samplers", default=",".join(MITSUBA))
     ap.add_argument("--cache", default="")
+    ap.add_argument("--clamp", type=float, default=0, help="clip both images to [0, C] before the error (0: off)")
     ap.add_argument("--table-only", action="store_true")
     ap.add_argument("--retime", type=int, default=0, metavar="R",
                     help="R more timing rounds over the last run's rows (interleaved), then the table")
@@ -158,7 +170,7 @@ def main():
     # so MSE_ref = MSE_ind(N) x N / ref_spp; measured at the first level (Mitsuba, noise of the
     # reference included, hence ref_spp + N).
     n0 = args.levels[0]
-    mse_ind = np.mean([np.mean((mitsuba_render(args, "independent", 500 + s, n0)[0] - ref) ** 2) for s in range(args.seeds)])
+    mse_ind = np.mean([sq_err(args, mitsuba_render(args, "independent", 500 + s, n0)[0], ref) for s in range(args.seeds)])
     ref_mse = mse_ind * n0 / (args.ref_spp + n0)
     rows = []
     for renderer, samplers in (("candela", args.candela_samplers), ("mitsuba", args.mitsuba_samplers)):
@@ -191,7 +203,7 @@ def print_table(args, rows, ref_mse):
     base = None
     print(f"{args.scene} {args.res}x{height(args)}, {args.threads} threads, {args.seeds} seeds per level, reference Mitsuba "
           f"independent {args.ref_spp} spp (its RMSE {math.sqrt(ref_mse):.5f}, taken out); "
-          f"target RMSE {target:.5f}\n")
+          f"target RMSE {target:.5f}" + (f", images clipped to [0, {args.clamp:g}]" if args.clamp > 0 else "") + "\n")
     lv = " | ".join(f"RMSE @{n}" for n in args.levels)
     print(f"| renderer | sampler | Msamples/s | {lv} | spp to target | time to target (s) | speed-up |")
     print("|---|---|---|" + "---|" * len(args.levels) + "---|---|---|")
