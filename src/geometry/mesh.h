@@ -9,6 +9,13 @@ namespace candela {
 // All the scene's triangles in world space, in one indexed array: accelerators see one list of
 // primitives (the triangle index is the primitive id) and never chase pointers to per-shape meshes.
 // A Shape is a contiguous run of triangles that share a material and an emitter.
+// The unit geometric normal of a triangle, from its winding; +z for a degenerate one.
+inline vec3 face_normal(vec3 p0, vec3 p1, vec3 p2) {
+    vec3 ng = glm::cross(p1 - p0, p2 - p0);
+    float len = glm::length(ng);
+    return len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
+}
+
 struct Mesh {
     std::vector<vec3> positions;
     std::vector<vec3> normals;       // per vertex; empty, or the same size as positions
@@ -20,6 +27,18 @@ struct Mesh {
     std::vector<vec3> colors;
     std::vector<uvec3> triangles;    // vertex indices
     std::vector<uint32_t> tri_shape; // shape index of each triangle
+    // face_normal() of each triangle, filled once the mesh is final (build_scene): a hit then reads
+    // it instead of a cross product, a square root and a division. Empty before.
+    std::vector<vec3> face_normals;
+
+    void compute_face_normals() {
+        face_normals.resize(triangles.size());
+        for (size_t i = 0; i < triangles.size(); ++i) {
+            vec3 a, b, c;
+            vertices(uint32_t(i), a, b, c);
+            face_normals[i] = face_normal(a, b, c);
+        }
+    }
 
     size_t triangle_count() const { return triangles.size(); }
     void vertices(uint32_t tri, vec3& p0, vec3& p1, vec3& p2) const {

@@ -116,6 +116,19 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
     choices_ = uint32_t(lights_.size()) + (has_area() ? 1u : 0u);
     choice_pmf_ = choices_ > 0 ? 1.f / float(choices_) : 0.f;
     area_pmf_ = has_area() ? choice_pmf_ : 0.f;
+
+    etris_.clear();
+    etris_.reserve(tris_.size());
+    for (size_t i = 0; i < tris_.size(); ++i) {
+        EmissiveTriangle et;
+        mesh.vertices(tris_[i], et.p0, et.p1, et.p2);
+        // Its area is > 0 (zero-weight triangles are not in tris_), so is this length.
+        const vec3 ng = glm::cross(et.p1 - et.p0, et.p2 - et.p0);
+        et.ng = ng / glm::length(ng);
+        et.pmf_area = dist_.pmf(i) / area_[i];
+        et.pdf_area = area_pmf_ * dist_.pmf(i) / area_[i];
+        etris_.push_back(et);
+    }
 }
 
 // Exact point and its error bound from barycentrics (pbrt-v4 uses gamma(6) for this sum).
@@ -167,15 +180,11 @@ bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) c
         out.pdf = pmf * as.pdf;
         return std::isfinite(out.pdf) && out.pdf > 0.f;
     }
-    uint32_t tri = tris_[i];
-    vec3 p0, p1, p2;
-    mesh_->vertices(tri, p0, p1, p2);
+    const uint32_t tri = tris_[i];
+    const EmissiveTriangle& et = etris_[i];
     vec2 b = square_to_uniform_triangle(u2);
-    interpolate_point(p0, p1, p2, b.x, b.y, 1.f - b.x - b.y, out.p, out.p_error);
-    vec3 ng = glm::cross(p1 - p0, p2 - p0);
-    float len = glm::length(ng);
-    if (!(len > 0.f)) return false;
-    ng /= len;
+    interpolate_point(et.p0, et.p1, et.p2, b.x, b.y, 1.f - b.x - b.y, out.p, out.p_error);
+    const vec3 ng = et.ng;
     vec3 ns = ng;
     if (!mesh_->normals.empty()) {
         // One-sidedness follows the shading normal, as for BSDFs.
@@ -194,7 +203,7 @@ bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) c
     // interpolate_point weighs p0, p1, p2 by (b.x, b.y, 1 - b.x - b.y).
     out.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
                                                          : radiance_[i];
-    out.pdf = pmf / area_[i] * dist2 / std::abs(cos_light);
+    out.pdf = et.pmf_area * dist2 / std::abs(cos_light);
     return std::isfinite(out.pdf) && out.pdf > 0.f;
 }
 
@@ -212,7 +221,7 @@ float LightSet::pdf_li(vec3 ref_p, const SurfaceInteraction& on_light) const {
     float dist2 = glm::dot(d, d);
     float cos_light = std::abs(glm::dot(d, on_light.ng)) / std::sqrt(dist2);
     if (!(cos_light > 0.f)) return 0.f;
-    return area_pmf_ * dist_.pmf(size_t(li)) / area_[size_t(li)] * dist2 / cos_light;
+    return etris_[size_t(li)].pdf_area * dist2 / cos_light;
 }
 
 vec3 LightSet::emitted(const SurfaceInteraction& on_light, vec3 w) const {
@@ -268,15 +277,11 @@ bool LightSet::sample_position(float u_sel, vec2 u_pos, PositionSample& out) con
         area = a.area;
         out.Le = emitter_radiance_[size_t(analytic_emitter_[ai])];
     } else {
-        uint32_t tri = tris_[i];
-        vec3 p0, p1, p2;
-        mesh_->vertices(tri, p0, p1, p2);
+        const uint32_t tri = tris_[i];
+        const EmissiveTriangle& et = etris_[i];
         vec2 b = square_to_uniform_triangle(u_pos);
-        interpolate_point(p0, p1, p2, b.x, b.y, 1.f - b.x - b.y, si.p, si.p_error);
-        vec3 ng = glm::cross(p1 - p0, p2 - p0);
-        float len = glm::length(ng);
-        if (!(len > 0.f)) return false;
-        si.ng = si.ns = ng / len;
+        interpolate_point(et.p0, et.p1, et.p2, b.x, b.y, 1.f - b.x - b.y, si.p, si.p_error);
+        si.ng = si.ns = et.ng;
         if (!mesh_->normals.empty()) {
             const uvec3& t = mesh_->triangles[tri];
             vec3 n = b.x * mesh_->normals[t.x] + b.y * mesh_->normals[t.y] + (1.f - b.x - b.y) * mesh_->normals[t.z];

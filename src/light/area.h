@@ -108,7 +108,8 @@ public:
     size_t memory_bytes() const {
         return tris_.capacity() * sizeof(uint32_t) + area_.capacity() * sizeof(float) +
                radiance_.capacity() * sizeof(vec3) + prim_light_.capacity() * sizeof(int32_t) +
-               tri_emitter_.capacity() * sizeof(int32_t) + emitter_radiance_.capacity() * sizeof(vec3) +
+               tri_emitter_.capacity() * sizeof(int32_t) +
+               etris_.capacity() * sizeof(EmissiveTriangle) + emitter_radiance_.capacity() * sizeof(vec3) +
                alights_.capacity() * sizeof(uint32_t) + analytic_light_.capacity() * sizeof(int32_t) +
                analytic_emitter_.capacity() * sizeof(int32_t) + dist_.memory_bytes() +
                lights_.capacity() * sizeof(Light) + infinite_.capacity() * sizeof(uint32_t) +
@@ -122,6 +123,16 @@ private:
     std::vector<vec3> radiance_;          // their radiance
     std::vector<int32_t> prim_light_;     // triangle id -> index into tris_, or -1
     std::vector<int32_t> tri_emitter_;    // triangle id -> emitter index, or -1
+    // Per entry of tris_, what a light sample needs without going through the mesh: computed once
+    // in build(), with the same expressions the samplers used per call, so the values (and images)
+    // are the same bit for bit.
+    struct EmissiveTriangle {
+        vec3 p0, p1, p2;
+        vec3 ng;          // unit geometric normal: cross(p1 - p0, p2 - p0) / its length
+        float pmf_area;   // pmf / area: density by area before the choice pmf (sample_area_li)
+        float pdf_area;   // area_pmf_ * pmf / area: the same with it (pdf_li, pdf_le)
+    };
+    std::vector<EmissiveTriangle> etris_;
     std::vector<vec3> emitter_radiance_;
     std::vector<const Texture*> emitter_texture_;  // per emitter, null unless textured
     const std::vector<Shape>* shapes_ = nullptr;

@@ -1,7 +1,26 @@
 #pragma once
+#include <array>
 #include <cstdint>
 
 namespace candela {
+
+namespace detail {
+// PCG32::advance's multiplier and increment factor after k of its doublings: kMult^(2^k) and
+// prod_{j<k} (kMult^(2^j) + 1), both mod 2^64.
+struct PcgDoubling {
+    uint64_t mult, plus;
+};
+constexpr std::array<PcgDoubling, 64> pcg_doublings(uint64_t mult) {
+    std::array<PcgDoubling, 64> d{};
+    uint64_t plus = 1u;
+    for (auto& e : d) {
+        e = {mult, plus};
+        plus *= mult + 1u;
+        mult *= mult;
+    }
+    return d;
+}
+}  // namespace detail
 
 // PCG32 (O'Neill 2014, "PCG: A family of simple fast space-efficient statistically good algorithms
 // for random number generation"): 64-bit LCG state, XSH-RR output. Each `seq` selects an
@@ -36,8 +55,15 @@ public:
     float next_float() { return float(next_u32() >> 8) * 0x1p-24f; }
 
     // Jump ahead by delta steps (Brown 1994, "Random number generation with arbitrary strides").
+    // The doublings for delta's trailing zero bits come from a table: the samplers advance by
+    // multiples of 2^16. Integer arithmetic mod 2^64, so the state is the same as doubling each time.
     void advance(uint64_t delta) {
-        uint64_t cur_mult = kMult, cur_plus = inc_, acc_mult = 1u, acc_plus = 0u;
+        if (delta == 0) return;
+        static constexpr std::array<detail::PcgDoubling, 64> kDoublings = detail::pcg_doublings(kMult);
+        const int k = __builtin_ctzll(delta);
+        delta >>= k;
+        uint64_t cur_mult = kDoublings[size_t(k)].mult, cur_plus = kDoublings[size_t(k)].plus * inc_;
+        uint64_t acc_mult = 1u, acc_plus = 0u;
         while (delta > 0) {
             if (delta & 1) {
                 acc_mult *= cur_mult;

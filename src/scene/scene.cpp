@@ -181,6 +181,8 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
                        std::move(desc.lights)};
     check_params(desc.source, desc.shapes, params);
 
+    desc.mesh.compute_face_normals();
+    for (ShapeGroup& g : desc.groups) g.mesh.compute_face_normals();
     auto geometry = std::make_shared<Geometry>();
     geometry->mesh = std::move(desc.mesh);
     geometry->shapes = std::move(desc.shapes);
@@ -231,9 +233,7 @@ SurfaceInteraction triangle_interaction(const Mesh& mesh, const std::vector<Shap
     float b0 = 1.f - hit.b1 - hit.b2;
     si.p = b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
     si.p_error = gamma_bound(7) * (glm::abs(b0 * p0) + glm::abs(hit.b1 * p1) + glm::abs(hit.b2 * p2));
-    vec3 ng = glm::cross(p1 - p0, p2 - p0);
-    float len = glm::length(ng);
-    si.ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
+    si.ng = mesh.face_normals.empty() ? face_normal(p0, p1, p2) : mesh.face_normals[hit.prim];
     si.ns = si.ng;
     if (shapes[si.shape].smooth) {
         vec3 n = b0 * mesh.normals[t.x] + hit.b1 * mesh.normals[t.y] + hit.b2 * mesh.normals[t.z];
@@ -309,13 +309,13 @@ Scene::Memory Scene::memory() const {
     m.triangles = mesh.triangles.size();
     m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
              mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t) +
-             mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
+             mesh.face_normals.capacity() * sizeof(vec3) + mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
     m.instances = instances.size();
     for (const ShapeGroup& g : groups) {
         m.triangles += g.mesh.triangles.size();
         m.mesh += g.mesh.positions.capacity() * sizeof(vec3) + g.mesh.normals.capacity() * sizeof(vec3) +
                   g.mesh.triangles.capacity() * sizeof(uvec3) + g.mesh.tri_shape.capacity() * sizeof(uint32_t) +
-                  g.mesh.uvs.capacity() * sizeof(vec2) + g.mesh.colors.capacity() * sizeof(vec3) +
+                  g.mesh.face_normals.capacity() * sizeof(vec3) + g.mesh.uvs.capacity() * sizeof(vec2) + g.mesh.colors.capacity() * sizeof(vec3) +
                   g.analytic.capacity() * sizeof(AnalyticShape);
     }
     m.mesh += instances.capacity() * sizeof(Instance);
