@@ -6,9 +6,6 @@
 
 namespace candela {
 
-// All the scene's triangles in world space, in one indexed array: accelerators see one list of
-// primitives (the triangle index is the primitive id) and never chase pointers to per-shape meshes.
-// A Shape is a contiguous run of triangles that share a material and an emitter.
 // The unit geometric normal of a triangle, from its winding; +z for a degenerate one.
 inline vec3 face_normal(vec3 p0, vec3 p1, vec3 p2) {
     vec3 ng = glm::cross(p1 - p0, p2 - p0);
@@ -16,6 +13,9 @@ inline vec3 face_normal(vec3 p0, vec3 p1, vec3 p2) {
     return len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
 }
 
+// All the scene's triangles in world space, in one indexed array: accelerators see one list of
+// primitives (the triangle index is the primitive id) and never chase pointers to per-shape meshes.
+// A Shape is a contiguous run of triangles that share a material and an emitter.
 struct Mesh {
     std::vector<vec3> positions;
     std::vector<vec3> normals;       // per vertex; empty, or the same size as positions
@@ -41,6 +41,12 @@ struct Mesh {
     }
 
     size_t triangle_count() const { return triangles.size(); }
+    // Bytes held by the arrays (capacity), for Scene::memory.
+    size_t memory_bytes() const {
+        return positions.capacity() * sizeof(vec3) + normals.capacity() * sizeof(vec3) +
+               triangles.capacity() * sizeof(uvec3) + tri_shape.capacity() * sizeof(uint32_t) +
+               face_normals.capacity() * sizeof(vec3) + uvs.capacity() * sizeof(vec2) + colors.capacity() * sizeof(vec3);
+    }
     void vertices(uint32_t tri, vec3& p0, vec3& p1, vec3& p2) const {
         const uvec3& t = triangles[tri];
         p0 = positions[t.x];

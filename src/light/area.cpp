@@ -122,9 +122,8 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
     for (size_t i = 0; i < tris_.size(); ++i) {
         EmissiveTriangle et;
         mesh.vertices(tris_[i], et.p0, et.p1, et.p2);
-        // Its area is > 0 (zero-weight triangles are not in tris_), so is this length.
-        const vec3 ng = glm::cross(et.p1 - et.p0, et.p2 - et.p0);
-        et.ng = ng / glm::length(ng);
+        // Its area is > 0 (zero-weight triangles are not in tris_): never face_normal's +z fallback.
+        et.ng = face_normal(et.p0, et.p1, et.p2);
         et.pmf_area = dist_.pmf(i) / area_[i];
         et.pdf_area = area_pmf_ * dist_.pmf(i) / area_[i];
         etris_.push_back(et);

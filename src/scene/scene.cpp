@@ -307,16 +307,11 @@ vec3 Scene::vertex_color(const Hit& hit) const {
 Scene::Memory Scene::memory() const {
     Memory m;
     m.triangles = mesh.triangles.size();
-    m.mesh = mesh.positions.capacity() * sizeof(vec3) + mesh.normals.capacity() * sizeof(vec3) +
-             mesh.triangles.capacity() * sizeof(uvec3) + mesh.tri_shape.capacity() * sizeof(uint32_t) +
-             mesh.face_normals.capacity() * sizeof(vec3) + mesh.uvs.capacity() * sizeof(vec2) + mesh.colors.capacity() * sizeof(vec3);
+    m.mesh = mesh.memory_bytes();
     m.instances = instances.size();
     for (const ShapeGroup& g : groups) {
         m.triangles += g.mesh.triangles.size();
-        m.mesh += g.mesh.positions.capacity() * sizeof(vec3) + g.mesh.normals.capacity() * sizeof(vec3) +
-                  g.mesh.triangles.capacity() * sizeof(uvec3) + g.mesh.tri_shape.capacity() * sizeof(uint32_t) +
-                  g.mesh.face_normals.capacity() * sizeof(vec3) + g.mesh.uvs.capacity() * sizeof(vec2) + g.mesh.colors.capacity() * sizeof(vec3) +
-                  g.analytic.capacity() * sizeof(AnalyticShape);
+        m.mesh += g.mesh.memory_bytes() + g.analytic.capacity() * sizeof(AnalyticShape);
     }
     m.mesh += instances.capacity() * sizeof(Instance);
     m.accel = accel ? accel->memory_bytes() : 0;
