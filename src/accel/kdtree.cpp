@@ -357,12 +357,14 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         KdTree& t;
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
-        // Appends the leaf's triangles as blocks of four (the last lane repeated to fill a block).
+        // Appends the leaf's triangles as blocks of kBlockLanes (the last triangle repeated to fill
+        // a block).
         uint32_t add_blocks(const std::vector<uint32_t>& prims) {
+            constexpr size_t kLanes = KdTree::kBlockLanes;
             const uint32_t first = uint32_t(t.blocks_.size());
-            for (size_t i = 0; i < prims.size(); i += 4) {
+            for (size_t i = 0; i < prims.size(); i += kLanes) {
                 TriBlock b;
-                for (size_t k = 0; k < 4; ++k) {
+                for (size_t k = 0; k < kLanes; ++k) {
                     const uint32_t prim = list[prims[std::min(i + k, prims.size() - 1)]];
                     vec3 v[3];
                     mesh.vertices(prim, v[0], v[1], v[2]);

@@ -1,12 +1,13 @@
-// K-d tree traversal (KdTree::intersect and KdTree::occluded) with its 4-wide triangle test.
+// K-d tree traversal (KdTree::intersect and KdTree::occluded) with its SIMD triangle test.
 //
 // The SIMD is Google Highway, compiled once per instruction set that the target architecture
 // offers (foreach_target: SSSE3, SSE4, AVX2 on x86; NEON and SVE on aarch64; a scalar fallback
 // everywhere) and chosen at run time for the CPU, once per ray (HWY_DYNAMIC_DISPATCH: one indirect
-// call, like the Accel's virtual one). Runtime dispatch, although the kernel is 128 bits: static
-// dispatch at the x86-64 baseline would get Highway 1.0.3's scalar fallback. The vectors are 4
-// lanes of float whatever the target: a leaf block holds 4 triangles (KdTree::TriBlock), so wider
-// vectors would have nothing to fill their other lanes with. docs/accel.md has the measurements.
+// call, like the Accel's virtual one). Runtime dispatch: static dispatch at the x86-64 baseline
+// would get Highway 1.0.3's scalar fallback. A leaf block holds 8 triangles (KdTree::TriBlock):
+// AVX2 tests them in one step of 8 lanes, the 128-bit targets (SSSE3, SSE4, NEON, and SVE, whose
+// vectors may be no wider) in two steps of 4, the scalar fallback in 8 steps of 1.
+// docs/accel.md has the measurements.
 //
 // Exactness: each lane of triangle_hits4 is intersect_triangle() (geometry/triangle.h) on that
 // triangle, bit for bit. That holds only without fused multiply-add: the AVX2, AVX-512, NEON and
@@ -20,9 +21,10 @@
 #include "core/math.h"
 #include "geometry/triangle.h"
 
-// No AVX-512 code: with 4 lanes it only changes the encoding, and it measured 0.83x on the Cornell
-// box's camera rays (any hit) where AVX2 and SSE4 match the raw-SSE version (docs/accel.md). The
-// dispatch then takes AVX2 on an AVX-512 CPU (the chosen target is masked per translation unit).
+// No AVX-512 code: with 8 lanes it only changes the encoding, and with the 4-lane blocks of
+// 2026-12-05 it measured 0.83x on the Cornell box's camera rays (any hit) where AVX2 and SSE4
+// matched the raw-SSE version (docs/accel.md). The dispatch then takes AVX2 on an AVX-512 CPU (the
+// chosen target is masked per translation unit).
 #ifndef HWY_DISABLED_TARGETS
 #define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL)
 #endif
@@ -49,15 +51,25 @@ namespace HWY_NAMESPACE {
 namespace {
 
 namespace hn = hwy::HWY_NAMESPACE;
-// One lane per triangle of a TriBlock: 4 lanes, except on HWY_SCALAR (the fallback target of
-// GCC < 12.3, whose EMU128 Highway disables), which has 1 and takes a block in 4 steps.
-using D4 = hn::CappedTag<float, 4>;
-using V4 = hn::Vec<D4>;
-using M4 = hn::Mask<D4>;
+// One lane per triangle of a TriBlock, kStep triangles per step: 8 on the 256-bit x86 targets,
+// 1 on HWY_SCALAR (the fallback target of GCC < 12.3, whose EMU128 Highway disables), and 4
+// elsewhere (SVE included: its vectors may be 128 bits, and a capped tag's MaxLanes is the cap).
+#if HWY_TARGET == HWY_SCALAR
+constexpr int kStepWanted = 1;
+#elif HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+constexpr int kStepWanted = 8;
+#else
+constexpr int kStepWanted = 4;
+#endif
+using DL = hn::CappedTag<float, kStepWanted>;
+using VL = hn::Vec<DL>;
+using ML = hn::Mask<DL>;
 using D1 = hn::CappedTag<float, 1>;  // one float, for branch-free selects in the walk from the origin
 using V1 = hn::Vec<D1>;
-constexpr int kStep = int(hn::MaxLanes(D4()));
-static_assert(4 % kStep == 0, "a block is a whole number of vectors");
+constexpr int kStep = int(hn::MaxLanes(DL()));
+constexpr int kLanes = KdTree::kBlockLanes;
+static_assert(kStep == kStepWanted && kLanes % kStep == 0, "a block is a whole number of vectors");
+constexpr unsigned kStepMask = (1u << kStep) - 1u;
 
 // Widening of a ray parameter by 2^-16 of its size: room for the rounding of split-plane
 // distances and of triangle hit distances (both a few ulps) so that the traversal never culls a
@@ -73,7 +85,7 @@ struct RayData {
     // The origin as compared with split planes: o_above[a] > split exactly when the origin lies
     // above the plane, or on it moving up (o rounded up to the next float when d > 0).
     float o_above[3];
-    int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the 4-wide filter
+    int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the SIMD filter
     float sx, sy, sz;
     RayData(const Ray& ray, const RayShear& sh) {
         kx = sh.kx;
@@ -91,98 +103,98 @@ struct RayData {
     }
 };
 
-// Lane k of the mask as bit k (what movemask gives on x86).
-inline unsigned lane_bits(M4 m) {
+// Lane k of the mask as bit k (what movemask gives on x86); at most 8 lanes.
+inline unsigned lane_bits(ML m) {
     uint8_t bits[8];  // StoreMaskBits may write up to 8 bytes
-    hn::StoreMaskBits(D4(), m, bits);
+    hn::StoreMaskBits(DL(), m, bits);
     return bits[0];
 }
 
-// intersect_triangle() (geometry/triangle.h) on four triangles at once: the translation, the
+// intersect_triangle() (geometry/triangle.h) on kStep triangles at once: the translation, the
 // shear, the edge functions, the degenerate-triangle check, the determinant, the scaled distance
 // and its interval check, the division, and the error bound on t, with the same float operations
 // in the same order (Mul then Add, never MulAdd, and no contraction: see the top of the file;
 // max and abs written to give what std::max and glm::abs give), so each lane's result is the
 // scalar test's, bit for bit. Lanes with an edge function exactly 0 are left to the scalar test
 // itself (it redoes them in double): they come back in `scalar`. The hits come back in the
-// return value, with t, b1 and b2 in `out`. `lanes` holds the lanes in use. Bit k of a mask is
-// lane k of the block.
-struct Hits4 {
-    alignas(16) float t[4], b1[4], b2[4];
+// return value, with t, b1 and b2 in `out` (indexed by block lane). `lanes` holds the step's
+// lanes in use; bit k of a mask is lane c + k of the block.
+struct BlockHits {
+    alignas(32) float t[kLanes], b1[kLanes], b2[kLanes];
 };
 // Lanes c to c + kStep - 1 of the block (bit 0 is lane c).
 inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, float tmin, float tmax, unsigned lanes,
-                          unsigned& scalar, Hits4& out) {
-    const D4 d;
+                          unsigned& scalar, BlockHits& out) {
+    const DL d;
     // Vectors one by one, not in arrays: SVE vectors are sizeless and cannot be array elements.
     auto load = [&](int v, int axis) { return hn::Load(d, b.v[v][axis] + c); };
-    const V4 sx = hn::Set(d, r.sx), sy = hn::Set(d, r.sy), sz = hn::Set(d, r.sz);
-    const V4 ox = hn::Set(d, r.o[r.kx]), oy = hn::Set(d, r.o[r.ky]), oz = hn::Set(d, r.o[r.kz]);
+    const VL sx = hn::Set(d, r.sx), sy = hn::Set(d, r.sy), sz = hn::Set(d, r.sz);
+    const VL ox = hn::Set(d, r.o[r.kx]), oy = hn::Set(d, r.o[r.ky]), oz = hn::Set(d, r.o[r.kz]);
     // a = p - o, then a[kx] + sx * a[kz], a[ky] + sy * a[kz] and sz * a[kz], for p0, p1, p2.
-    const V4 az0 = hn::Sub(load(0, r.kz), oz), az1 = hn::Sub(load(1, r.kz), oz), az2 = hn::Sub(load(2, r.kz), oz);
-    const V4 x0 = hn::Add(hn::Sub(load(0, r.kx), ox), hn::Mul(sx, az0));
-    const V4 x1 = hn::Add(hn::Sub(load(1, r.kx), ox), hn::Mul(sx, az1));
-    const V4 x2 = hn::Add(hn::Sub(load(2, r.kx), ox), hn::Mul(sx, az2));
-    const V4 y0 = hn::Add(hn::Sub(load(0, r.ky), oy), hn::Mul(sy, az0));
-    const V4 y1 = hn::Add(hn::Sub(load(1, r.ky), oy), hn::Mul(sy, az1));
-    const V4 y2 = hn::Add(hn::Sub(load(2, r.ky), oy), hn::Mul(sy, az2));
-    const V4 z0 = hn::Mul(sz, az0), z1 = hn::Mul(sz, az1), z2 = hn::Mul(sz, az2);
-    const V4 e0 = hn::Sub(hn::Mul(x1, y2), hn::Mul(y1, x2));
-    const V4 e1 = hn::Sub(hn::Mul(x2, y0), hn::Mul(y2, x0));
-    const V4 e2 = hn::Sub(hn::Mul(x0, y1), hn::Mul(y0, x1));
+    const VL az0 = hn::Sub(load(0, r.kz), oz), az1 = hn::Sub(load(1, r.kz), oz), az2 = hn::Sub(load(2, r.kz), oz);
+    const VL x0 = hn::Add(hn::Sub(load(0, r.kx), ox), hn::Mul(sx, az0));
+    const VL x1 = hn::Add(hn::Sub(load(1, r.kx), ox), hn::Mul(sx, az1));
+    const VL x2 = hn::Add(hn::Sub(load(2, r.kx), ox), hn::Mul(sx, az2));
+    const VL y0 = hn::Add(hn::Sub(load(0, r.ky), oy), hn::Mul(sy, az0));
+    const VL y1 = hn::Add(hn::Sub(load(1, r.ky), oy), hn::Mul(sy, az1));
+    const VL y2 = hn::Add(hn::Sub(load(2, r.ky), oy), hn::Mul(sy, az2));
+    const VL z0 = hn::Mul(sz, az0), z1 = hn::Mul(sz, az1), z2 = hn::Mul(sz, az2);
+    const VL e0 = hn::Sub(hn::Mul(x1, y2), hn::Mul(y1, x2));
+    const VL e1 = hn::Sub(hn::Mul(x2, y0), hn::Mul(y2, x0));
+    const VL e2 = hn::Sub(hn::Mul(x0, y1), hn::Mul(y0, x1));
     // Edge test. With no edge exactly 0, "some edge negative and some positive" is "the sign bits
     // differ", read as an integer sign (a float compare would miss -0 and NaN bit patterns). A NaN
     // edge may go either way: the scalar test rejects NaN lanes too (at t).
-    const V4 zero = hn::Zero(d);
-    const M4 any_zero = hn::Or(hn::Or(hn::Eq(e0, zero), hn::Eq(e1, zero)), hn::Eq(e2, zero));
+    const VL zero = hn::Zero(d);
+    const ML any_zero = hn::Or(hn::Or(hn::Eq(e0, zero), hn::Eq(e1, zero)), hn::Eq(e2, zero));
     const unsigned zero_edge = lane_bits(any_zero) & lanes;
-    const hn::RebindToSigned<D4> di;
+    const hn::RebindToSigned<DL> di;
     const auto sign_mix = hn::BitCast(di, hn::Or(hn::Xor(e0, e1), hn::Xor(e0, e2)));
     uint8_t out_bits[8];
     hn::StoreMaskBits(di, hn::Lt(sign_mix, hn::Zero(di)), out_bits);
-    const unsigned edge_out = out_bits[0];
+    const unsigned edge_out = out_bits[0] & kStepMask;
     scalar = zero_edge;
     unsigned live = ~edge_out & lanes & ~zero_edge;
-    if (!live) return 0;  // the usual case: the ray misses all four
+    if (!live) return 0;  // the usual case: the ray misses them all
     // Degenerate (collinear) triangles: n = cross(p1 - p0, p2 - p0) == 0, as glm::cross computes it.
-    const V4 ux = hn::Sub(load(1, 0), load(0, 0)), wx = hn::Sub(load(2, 0), load(0, 0));
-    const V4 uy = hn::Sub(load(1, 1), load(0, 1)), wy = hn::Sub(load(2, 1), load(0, 1));
-    const V4 uz = hn::Sub(load(1, 2), load(0, 2)), wz = hn::Sub(load(2, 2), load(0, 2));
-    const V4 nx = hn::Sub(hn::Mul(uy, wz), hn::Mul(wy, uz));
-    const V4 ny = hn::Sub(hn::Mul(uz, wx), hn::Mul(wz, ux));
-    const V4 nz = hn::Sub(hn::Mul(ux, wy), hn::Mul(wx, uy));
-    const M4 degenerate = hn::And(hn::And(hn::Eq(nx, zero), hn::Eq(ny, zero)), hn::Eq(nz, zero));
+    const VL ux = hn::Sub(load(1, 0), load(0, 0)), wx = hn::Sub(load(2, 0), load(0, 0));
+    const VL uy = hn::Sub(load(1, 1), load(0, 1)), wy = hn::Sub(load(2, 1), load(0, 1));
+    const VL uz = hn::Sub(load(1, 2), load(0, 2)), wz = hn::Sub(load(2, 2), load(0, 2));
+    const VL nx = hn::Sub(hn::Mul(uy, wz), hn::Mul(wy, uz));
+    const VL ny = hn::Sub(hn::Mul(uz, wx), hn::Mul(wz, ux));
+    const VL nz = hn::Sub(hn::Mul(ux, wy), hn::Mul(wx, uy));
+    const ML degenerate = hn::And(hn::And(hn::Eq(nx, zero), hn::Eq(ny, zero)), hn::Eq(nz, zero));
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
     // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
-    const V4 det = hn::Add(hn::Add(e0, e1), e2);
-    const V4 ts = hn::Add(hn::Add(hn::Mul(e0, z0), hn::Mul(e1, z1)), hn::Mul(e2, z2));
-    const V4 vtmin = hn::Set(d, tmin), vtmax = hn::Set(d, tmax);
-    const V4 lo = hn::Mul(vtmin, det), hi = hn::Mul(vtmax, det);
-    const M4 out_neg = hn::And(hn::Lt(det, zero), hn::Or(hn::Ge(ts, lo), hn::Le(ts, hi)));
-    const M4 out_pos = hn::And(hn::Gt(det, zero), hn::Or(hn::Le(ts, lo), hn::Ge(ts, hi)));
-    M4 rejected = hn::Or(hn::Or(degenerate, hn::Eq(det, zero)), hn::Or(out_neg, out_pos));
+    const VL det = hn::Add(hn::Add(e0, e1), e2);
+    const VL ts = hn::Add(hn::Add(hn::Mul(e0, z0), hn::Mul(e1, z1)), hn::Mul(e2, z2));
+    const VL vtmin = hn::Set(d, tmin), vtmax = hn::Set(d, tmax);
+    const VL lo = hn::Mul(vtmin, det), hi = hn::Mul(vtmax, det);
+    const ML out_neg = hn::And(hn::Lt(det, zero), hn::Or(hn::Ge(ts, lo), hn::Le(ts, hi)));
+    const ML out_pos = hn::And(hn::Gt(det, zero), hn::Or(hn::Le(ts, lo), hn::Ge(ts, hi)));
+    ML rejected = hn::Or(hn::Or(degenerate, hn::Eq(det, zero)), hn::Or(out_neg, out_pos));
     live &= ~lane_bits(rejected);
     if (!live) return 0;
-    const V4 inv_det = hn::Div(hn::Set(d, 1.f), det);
-    const V4 t = hn::Mul(ts, inv_det);
+    const VL inv_det = hn::Div(hn::Set(d, 1.f), det);
+    const VL t = hn::Mul(ts, inv_det);
     // !(t > tmin && t < tmax): rounding, and NaN from degenerate input.
     rejected = hn::Or(hn::Not(hn::Gt(t, vtmin)), hn::Not(hn::Lt(t, vtmax)));
     // t must exceed its rounding error bound (pbrt-v4); max(a, max(b, c)) as std::max nests it.
     // Max's result for a NaN operand differs between targets, but a NaN here (a NaN coordinate or
     // edge) also makes t NaN, and the lane is rejected above whatever delta_t is.
-    auto vmax3 = [](V4 a, V4 b2, V4 c) { return hn::Max(hn::Max(c, b2), a); };
-    const V4 max_zt = vmax3(hn::Abs(z0), hn::Abs(z1), hn::Abs(z2));
-    const V4 max_xt = vmax3(hn::Abs(x0), hn::Abs(x1), hn::Abs(x2));
-    const V4 max_yt = vmax3(hn::Abs(y0), hn::Abs(y1), hn::Abs(y2));
-    const V4 delta_z = hn::Mul(hn::Set(d, gamma_bound(3)), max_zt);
-    const V4 delta_x = hn::Mul(hn::Set(d, gamma_bound(5)), hn::Add(max_xt, max_zt));
-    const V4 delta_y = hn::Mul(hn::Set(d, gamma_bound(5)), hn::Add(max_yt, max_zt));
-    const V4 delta_e =
+    auto vmax3 = [](VL a, VL b2, VL c) { return hn::Max(hn::Max(c, b2), a); };
+    const VL max_zt = vmax3(hn::Abs(z0), hn::Abs(z1), hn::Abs(z2));
+    const VL max_xt = vmax3(hn::Abs(x0), hn::Abs(x1), hn::Abs(x2));
+    const VL max_yt = vmax3(hn::Abs(y0), hn::Abs(y1), hn::Abs(y2));
+    const VL delta_z = hn::Mul(hn::Set(d, gamma_bound(3)), max_zt);
+    const VL delta_x = hn::Mul(hn::Set(d, gamma_bound(5)), hn::Add(max_xt, max_zt));
+    const VL delta_y = hn::Mul(hn::Set(d, gamma_bound(5)), hn::Add(max_yt, max_zt));
+    const VL delta_e =
         hn::Mul(hn::Set(d, 2.f), hn::Add(hn::Add(hn::Mul(hn::Mul(hn::Set(d, gamma_bound(2)), max_xt), max_yt),
                                                   hn::Mul(delta_y, max_xt)),
                                           hn::Mul(delta_x, max_yt)));
-    const V4 max_e = vmax3(hn::Abs(e0), hn::Abs(e1), hn::Abs(e2));
-    const V4 delta_t = hn::Mul(
+    const VL max_e = vmax3(hn::Abs(e0), hn::Abs(e1), hn::Abs(e2));
+    const VL delta_t = hn::Mul(
         hn::Mul(hn::Set(d, 3.f), hn::Add(hn::Add(hn::Mul(hn::Mul(hn::Set(d, gamma_bound(3)), max_e), max_zt),
                                                  hn::Mul(delta_e, max_zt)),
                                          hn::Mul(delta_z, max_e))),
@@ -195,13 +207,14 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     return live;
 }
 
-inline unsigned triangle_hits4(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes,
-                               unsigned& scalar, Hits4& out) {
-    if constexpr (kStep == 4) return hits_step(r, b, 0, tmin, tmax, lanes, scalar, out);
+// The whole block, a step at a time; `lanes` holds its lanes in use (bit k is lane k).
+inline unsigned triangle_hits(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes,
+                              unsigned& scalar, BlockHits& out) {
+    if constexpr (kStep == kLanes) return hits_step(r, b, 0, tmin, tmax, lanes, scalar, out);
     unsigned hits = 0;
     scalar = 0;
-    for (int c = 0; c < 4; c += kStep) {
-        const unsigned step_lanes = lanes >> c & ((1u << kStep) - 1u);
+    for (int c = 0; c < kLanes; c += kStep) {
+        const unsigned step_lanes = lanes >> c & kStepMask;
         if (!step_lanes) break;  // the block's unused lanes are its last ones
         unsigned step_scalar;
         hits |= hits_step(r, b, c, tmin, tmax, step_lanes, step_scalar, out) << c;
@@ -327,11 +340,11 @@ bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB
                 found = true;
             };
             const TriBlock* b = blocks + node->first;
-            for (uint32_t i = 0; i < count; i += 4, ++b) {
-                const uint32_t n4 = std::min(count - i, 4u);
+            for (uint32_t i = 0; i < count; i += kLanes, ++b) {
+                const uint32_t n = std::min(count - i, uint32_t(kLanes));
                 unsigned scalar;
-                Hits4 h4;
-                const unsigned hits = triangle_hits4(r, *b, ray.tmin, ray.tmax, (1u << n4) - 1u, scalar, h4);
+                BlockHits bh;
+                const unsigned hits = triangle_hits(r, *b, ray.tmin, ray.tmax, (1u << n) - 1u, scalar, bh);
                 if (Shadow && hits) return true;
                 // In lane order, as the scalar test would meet them: a later lane replaces an
                 // earlier hit only when strictly closer. Lanes with an edge function exactly 0 go
@@ -348,7 +361,7 @@ bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB
                         if constexpr (Shadow) return true;
                         record(th.t, th.b1, th.b2, b->prim[k]);
                     } else if constexpr (!Shadow) {
-                        if (h4.t[k] < ray.tmax) record(h4.t[k], h4.b1[k], h4.b2[k], b->prim[k]);
+                        if (bh.t[k] < ray.tmax) record(bh.t[k], bh.b1[k], bh.b2[k], b->prim[k]);
                     }
                 }
             }
