@@ -111,11 +111,11 @@ inline unsigned lane_bits(ML m) {
 }
 
 // intersect_triangle() (geometry/triangle.h) on kStep triangles at once: the translation, the
-// shear, the edge functions, the degenerate-triangle check, the determinant, the scaled distance
-// and its interval check, the division, and the error bound on t, with the same float operations
-// in the same order (Mul then Add, never MulAdd, and no contraction: see the top of the file;
-// max and abs written to give what std::max and glm::abs give), so each lane's result is the
-// scalar test's, bit for bit. Lanes with an edge function exactly 0 are left to the scalar test
+// shear, the edge functions, the determinant, the scaled distance and its interval check, the
+// division, and the error bound on t (the degenerate-triangle check is done once, at build; see
+// below), with the same float operations in the same order (Mul then Add, never MulAdd, and no
+// contraction: see the top of the file; max and abs written to give what std::max and glm::abs
+// give), so each lane's result is the scalar test's, bit for bit. Lanes with an edge function exactly 0 are left to the scalar test
 // itself (it redoes them in double): they come back in `scalar`. The hits come back in the
 // return value, with t, b1 and b2 in `out` (indexed by block lane). `lanes` holds the step's
 // lanes in use; bit k of a mask is lane c + k of the block.
@@ -156,14 +156,9 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     scalar = zero_edge;
     unsigned live = ~edge_out & lanes & ~zero_edge;
     if (!live) return 0;  // the usual case: the ray misses them all
-    // Degenerate (collinear) triangles: n = cross(p1 - p0, p2 - p0) == 0, as glm::cross computes it.
-    const VL ux = hn::Sub(load(1, 0), load(0, 0)), wx = hn::Sub(load(2, 0), load(0, 0));
-    const VL uy = hn::Sub(load(1, 1), load(0, 1)), wy = hn::Sub(load(2, 1), load(0, 1));
-    const VL uz = hn::Sub(load(1, 2), load(0, 2)), wz = hn::Sub(load(2, 2), load(0, 2));
-    const VL nx = hn::Sub(hn::Mul(uy, wz), hn::Mul(wy, uz));
-    const VL ny = hn::Sub(hn::Mul(uz, wx), hn::Mul(wz, ux));
-    const VL nz = hn::Sub(hn::Mul(ux, wy), hn::Mul(wx, uy));
-    const ML degenerate = hn::And(hn::And(hn::Eq(nx, zero), hn::Eq(ny, zero)), hn::Eq(nz, zero));
+    // Degenerate (collinear) triangles, which intersect_triangle() rejects after the edge test, are
+    // not in the tree (KdTree::build leaves them out), so no lane needs that check.
+    //
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
     // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
     const VL det = hn::Add(hn::Add(e0, e1), e2);
@@ -172,7 +167,7 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     const VL lo = hn::Mul(vtmin, det), hi = hn::Mul(vtmax, det);
     const ML out_neg = hn::And(hn::Lt(det, zero), hn::Or(hn::Ge(ts, lo), hn::Le(ts, hi)));
     const ML out_pos = hn::And(hn::Gt(det, zero), hn::Or(hn::Le(ts, lo), hn::Ge(ts, hi)));
-    ML rejected = hn::Or(hn::Or(degenerate, hn::Eq(det, zero)), hn::Or(out_neg, out_pos));
+    ML rejected = hn::Or(hn::Eq(det, zero), hn::Or(out_neg, out_pos));
     live &= ~lane_bits(rejected);
     if (!live) return 0;
     const VL inv_det = hn::Div(hn::Set(d, 1.f), det);
