@@ -10,8 +10,10 @@
 // Traversal (kdtree_trace.cpp): 8-byte nodes, a fixed-size stack, a template <bool Shadow> for the
 // any-hit variant, compiled per SIMD target (Highway) and chosen at run time. Leaves hold their
 // triangles' vertices in blocks of eight, laid out for the triangle test's vector lanes (a copy
-// per leaf reference): one 8-lane step on AVX2, two 4-lane steps on SSE4 and NEON. Every triangle test is the watertight intersect_triangle() on the mesh's own vertex
-// values, so a hit has the same t, bit for bit, as the brute-force oracle.
+// per leaf reference): one 8-lane step on AVX2, two 4-lane steps on SSE4 and NEON. Every triangle
+// test is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the
+// same t, bit for bit, as the brute-force oracle. Zero-area triangles, which it never hits, are
+// left out at build.
 #include <cstdint>
 #include <vector>
 #include "accel/accel.h"

@@ -9,7 +9,7 @@
 // vectors may be no wider) in two steps of 4, the scalar fallback in 8 steps of 1.
 // docs/accel.md has the measurements.
 //
-// Exactness: each lane of triangle_hits4 is intersect_triangle() (geometry/triangle.h) on that
+// Exactness: each lane of triangle_hits() is intersect_triangle() (geometry/triangle.h) on that
 // triangle, bit for bit. That holds only without fused multiply-add: the AVX2, AVX-512, NEON and
 // SVE targets have FMA, and GCC fuses a Mul followed by an Add (intrinsics included) by default in
 // C++. CMakeLists.txt therefore builds everything with -ffp-contract=off; the code below writes
@@ -115,10 +115,10 @@ inline unsigned lane_bits(ML m) {
 // division, and the error bound on t (the degenerate-triangle check is done once, at build; see
 // below), with the same float operations in the same order (Mul then Add, never MulAdd, and no
 // contraction: see the top of the file; max and abs written to give what std::max and glm::abs
-// give), so each lane's result is the scalar test's, bit for bit. Lanes with an edge function exactly 0 are left to the scalar test
-// itself (it redoes them in double): they come back in `scalar`. The hits come back in the
-// return value, with t, b1 and b2 in `out` (indexed by block lane). `lanes` holds the step's
-// lanes in use; bit k of a mask is lane c + k of the block.
+// give), so each lane's result is the scalar test's, bit for bit. Lanes with an edge function
+// exactly 0 are left to the scalar test itself (it redoes them in double): they come back in
+// `scalar`. The hits come back in the return value, with t, b1 and b2 in `out` (indexed by block
+// lane). `lanes` holds the step's lanes in use; bit k of a mask is lane c + k of the block.
 struct BlockHits {
     alignas(32) float t[kLanes], b1[kLanes], b2[kLanes];
 };
