@@ -319,10 +319,8 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         if (i % 4096 == 0 && interrupt_requested()) return interrupted_build();
         vec3 v[3];
         mesh.vertices(list[i], v[0], v[1], v[2]);
-        // A zero-area triangle (exactly zero normal, computed as intersect_triangle computes it)
-        // is never hit: it is left out, and the traversal's SIMD test need not check for it.
-        const vec3 nrm = glm::cross(v[1] - v[0], v[2] - v[0]);
-        if (nrm.x == 0.f && nrm.y == 0.f && nrm.z == 0.f) continue;
+        // Never hit: left out, so that the traversal's SIMD test need not check for it.
+        if (zero_area_triangle(v[0], v[1], v[2])) continue;
         AABB b;
         if (clip) {
             b = clipped_bounds(v, *clip);

@@ -157,7 +157,7 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     unsigned live = ~edge_out & lanes & ~zero_edge;
     if (!live) return 0;  // the usual case: the ray misses them all
     // Degenerate (collinear) triangles, which intersect_triangle() rejects after the edge test, are
-    // not in the tree (KdTree::build leaves them out), so no lane needs that check.
+    // not in the tree (KdTree::build leaves out zero_area_triangle()), so no lane needs that check.
     //
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
     // then its comparisons with tmin det and tmax det, whose sense follows det's sign.

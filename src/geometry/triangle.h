@@ -27,6 +27,13 @@ struct TriangleHit {
     float b1, b2;  // barycentrics of p1 and p2; p = (1-b1-b2) p0 + b1 p1 + b2 p2
 };
 
+// Whether the triangle has zero area as intersect_triangle() decides it (an exactly zero
+// cross(p1 - p0, p2 - p0)): it never hits such a triangle, and the k-d tree leaves them out.
+inline bool zero_area_triangle(vec3 p0, vec3 p1, vec3 p2) {
+    const vec3 n = glm::cross(p1 - p0, p2 - p0);
+    return n.x == 0.f && n.y == 0.f && n.z == 0.f;
+}
+
 // Returns true and fills `hit` when the ray meets the triangle with tmin < t < tmax.
 inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3 p1, vec3 p2, TriangleHit& hit) {
     // Translate to the ray origin and permute so that the largest direction component is z.
@@ -47,8 +54,7 @@ inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3
     // A zero-area triangle (collinear vertices) can pass the edge test: the shear rounds its edge
     // functions to tiny values of one sign. Reject it as pbrt-v4 does (checked here, after the
     // cheap edge test, so that it costs nothing for the many triangles that miss).
-    vec3 n = glm::cross(p1 - p0, p2 - p0);
-    if (n.x == 0.f && n.y == 0.f && n.z == 0.f) return false;
+    if (zero_area_triangle(p0, p1, p2)) return false;
     float det = e0 + e1 + e2;
     if (det == 0.f) return false;
 
