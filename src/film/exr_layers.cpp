@@ -90,6 +90,7 @@ std::map<std::string, std::vector<float>> read_exr_channels(const std::string& p
     for (int c = 0; c < header.num_channels; ++c) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
     EXRImage image;
     InitEXRImage(&image);
+    image.num_channels = header.num_channels;  // tinyexr frees the buffers on error (image_io.cpp, read_exr)
     rc = LoadEXRImageFromFile(&image, &header, path.c_str(), &err);
     if (rc != TINYEXR_SUCCESS) throw fail(rc);
     std::map<std::string, std::vector<float>> out;

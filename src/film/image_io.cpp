@@ -185,10 +185,15 @@ Image read_exr(const std::string& path, const std::vector<unsigned char>& data) 
         if (header.h.pixel_types[c] == TINYEXR_PIXELTYPE_HALF)
             header.h.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
 
-    // On a decoding error tinyexr 1.0.1 leaks its channel buffers (and freeing the image would
-    // double-free), so truncated scanline files, the common bad file, are caught here first.
+    // Truncated scanline files, the common bad file, get a precise message here first.
     if (!header.h.tiled) check_exr_chunks(path, header.h, data);
     ExrImageGuard image;
+    // On a decoding error tinyexr 1.0.1 frees the image with FreeEXRImage, which frees as many
+    // channel buffers as the image's channel count, but a scanline image gets its count only after
+    // a successful decode: the buffers leaked (a fuzzer finding, e.g. PIZ data that does not
+    // decode). With the count set beforehand its own cleanup frees them; on success it sets the
+    // same count. The failed image must not be freed again (its pointers are left dangling).
+    image.img.num_channels = header.h.num_channels;
     rc = LoadEXRImageFromMemory(&image.img, &header.h, data.data(), data.size(), &err.msg);
     if (rc != TINYEXR_SUCCESS) throw Error(path, 0, "cannot decode EXR pixels: " + err.text(rc));
     image.loaded = true;
