@@ -4,19 +4,24 @@
 # and whether the images agree within Monte Carlo noise (../shared/tools/imgcmp.py).
 #
 # Usage: bash bench/mitsuba/compare.sh [SCENE.xml] [--res N] [--spp N] [--max-depth M] [--threads T]
+#                                      [--embree-build DIR]
 #   SCENE defaults to scenes/cornell-box/scene.xml; --max-depth is MITSUBA's max_depth (path
 #   segments; candela gets M - 1 through the XML); default 8, i.e. 7 scattering events.
+#   --embree-build DIR: a build configured with -DCANDELA_EMBREE=ON; its candela renders the scene
+#   with the k-d tree and with Embree, in turn, and the ratio says how much of the distance to
+#   Mitsuba is the accelerator's (bench/RESULTS.md, "A mesh scene").
 # Output goes to out/bench-mitsuba/. Needs ../shared/tools (setup-reference.sh installs Mitsuba).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 scene=scenes/cornell-box/scene.xml
-res=256 spp=256 depth=8 threads=2
+res=256 spp=256 depth=8 threads=2 embree_build=
 while [ $# -gt 0 ]; do
   case "$1" in
     --res) res=$2; shift 2 ;;
     --spp) spp=$2; shift 2 ;;
     --max-depth) depth=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
+    --embree-build) embree_build=$2; shift 2 ;;
     -*) echo "compare.sh: unknown option $1" >&2; exit 2 ;;
     *) scene=$1; shift ;;
   esac
@@ -41,5 +46,17 @@ for variant in scalar_rgb llvm_ad_rgb; do
         "$out/mitsuba_$variant.json")
   echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(awk -v a="$c_sps" -v b="$sps" 'BEGIN{printf "%.2f", a / b}')"
 done
+if [ -n "$embree_build" ]; then
+  # The same binary with each accelerator, alternated twice (the machine's noise is +-10%).
+  for round in 1 2; do
+    for accel in kdtree embree; do
+      line=$("$embree_build/bin/candela" "$scene" "${defs[@]}" --accel $accel --frames "$spp" --threads "$threads" \
+             --out "$out/candela_$accel.exr" 2>&1 | tail -n 1)
+      eval "sps_$accel=$(echo "$line" | sed -n 's/.* \([0-9.]*\) Msamples\/s.*/\1/p')"
+    done
+    echo "$embree_build candela, round $round: kdtree $sps_kdtree, embree $sps_embree Msamples/s" \
+         "  kdtree/embree = $(awk -v a="$sps_kdtree" -v b="$sps_embree" 'BEGIN{printf "%.2f", a / b}')"
+  done
+fi
 echo "--- imgcmp candela vs mitsuba llvm_ad_rgb (same spp) ---"
 "$PY" $shared/imgcmp.py "$out/candela.exr" "$out/mitsuba_llvm_ad_rgb.exr" --spp "$spp" --ref-spp "$spp" || true
