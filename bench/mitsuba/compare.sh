@@ -34,28 +34,30 @@ mkdir -p "$out"
 defs=(-D "res=$res" -D "width=$res" -D "height=$res" -D "spp=$spp" -D "max_depth=$depth")
 
 echo "scene=$scene res=${res}x${res} spp=$spp mitsuba_max_depth=$depth threads=$threads machine=$(lscpu | sed -n 's/^Model name: *//p')"
-c_line=$(build/bin/candela "$scene" "${defs[@]}" --frames "$spp" --threads "$threads" --out "$out/candela.exr" 2>&1 | tail -n 1)
-c_sps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Msamples\/s.*/\1/p')
-c_rps=$(echo "$c_line" | sed -n 's/.* \([0-9.]*\) Mrays\/s.*/\1/p')
-echo "candela:            $c_sps Msamples/s ($c_rps Mrays/s)"
+# candela BINARY OUT.exr [ARGS...]: renders the scene, prints candela's summary line.
+render() {
+  local bin=$1 img=$2; shift 2
+  "$bin" "$scene" "${defs[@]}" --frames "$spp" --threads "$threads" --out "$img" "$@" 2>&1 | tail -n 1
+}
+rate() { sed -n "s/.* \([0-9.]*\) $1\/s.*/\1/p"; }  # a rate from a summary line: Msamples or Mrays
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN{printf "%.2f", a / b}'; }
+c_line=$(render build/bin/candela "$out/candela.exr")
+c_sps=$(echo "$c_line" | rate Msamples)
+echo "candela:            $c_sps Msamples/s ($(echo "$c_line" | rate Mrays) Mrays/s)"
 for variant in scalar_rgb llvm_ad_rgb; do
   "$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant $variant --spp "$spp" --threads "$threads" \
         --warmup --out "$out/mitsuba_$variant.exr" > "$out/mitsuba_$variant.log" 2>&1
   # The tool writes its timings next to the image as JSON (samples_per_s excludes load and warm-up).
   sps=$("$PY" -c 'import json, sys; print("%.3f" % (json.load(open(sys.argv[1]))["samples_per_s"] / 1e6))' \
         "$out/mitsuba_$variant.json")
-  echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(awk -v a="$c_sps" -v b="$sps" 'BEGIN{printf "%.2f", a / b}')"
+  echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(ratio "$c_sps" "$sps")"
 done
 if [ -n "$embree_build" ]; then
   # The same binary with each accelerator, alternated twice (the machine's noise is +-10%).
   for round in 1 2; do
-    for accel in kdtree embree; do
-      line=$("$embree_build/bin/candela" "$scene" "${defs[@]}" --accel $accel --frames "$spp" --threads "$threads" \
-             --out "$out/candela_$accel.exr" 2>&1 | tail -n 1)
-      eval "sps_$accel=$(echo "$line" | sed -n 's/.* \([0-9.]*\) Msamples\/s.*/\1/p')"
-    done
-    echo "$embree_build candela, round $round: kdtree $sps_kdtree, embree $sps_embree Msamples/s" \
-         "  kdtree/embree = $(awk -v a="$sps_kdtree" -v b="$sps_embree" 'BEGIN{printf "%.2f", a / b}')"
+    kd=$(render "$embree_build/bin/candela" "$out/candela_kdtree.exr" --accel kdtree | rate Msamples)
+    em=$(render "$embree_build/bin/candela" "$out/candela_embree.exr" --accel embree | rate Msamples)
+    echo "$embree_build candela, round $round: kdtree $kd, embree $em Msamples/s   kdtree/embree = $(ratio "$kd" "$em")"
   done
 fi
 echo "--- imgcmp candela vs mitsuba llvm_ad_rgb (same spp) ---"
