@@ -7,8 +7,9 @@ namespace {
 
 // path, volpath: Mitsuba's MonteCarloIntegrator parameters. Mitsuba's max_depth counts path
 // segments, candela's scattering events.
-void read_depths(const ParamSet& p, RenderSettings& st) {
-    int max_depth = p.get_int("max_depth", -1);
+// `default_depth` is Mitsuba's: -1 for the C++ integrators, 6 for the Python (differentiable) ones.
+void read_depths(const ParamSet& p, RenderSettings& st, int default_depth = -1) {
+    int max_depth = p.get_int("max_depth", default_depth);
     int rr_depth = p.get_int("rr_depth", 5);
     if (max_depth < -1) throw p.error("max_depth", "max_depth must be -1 (unbounded) or positive");
     // A Mitsuba depth of 0 renders black; that is never what a user wants, so it is rejected.
@@ -58,6 +59,21 @@ std::vector<AovSpec> parse_aovs(const ParamSet& p) {
     return out;
 }
 
+// The parameters of Mitsuba's projective-sampling integrators (ad/integrators/common.py,
+// PSIntegrator) steer only the derivative's estimator: read and checked, no effect on the image.
+void read_projective(const ParamSet& p) {
+    for (const char* n : {"sppc", "sppp", "sppi"})
+        if (p.has(n)) sample_count(p, n, 0);
+    const std::string guiding = p.get_string("guiding", "octree");
+    if (guiding != "none" && guiding != "grid" && guiding != "octree")
+        throw p.error("guiding", "guiding must be none, grid or octree");
+    p.get_bool("guiding_proj", true);
+    if (p.get_int("guiding_rounds", 1) < 0) throw p.error("guiding_rounds", "guiding_rounds must be >= 0");
+    const std::string seed = p.get_string("project_seed", "both");
+    if (seed != "both" && seed != "bsdf" && seed != "emitter")
+        throw p.error("project_seed", "project_seed must be both, bsdf or emitter");
+}
+
 }  // namespace
 
 IntegratorRole read_integrator(const std::string& type, const ParamSet& p, RenderSettings& st, int line) {
@@ -66,6 +82,38 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         // volpath is the path tracer in a scene without media; candela reads no <medium>, so a
         // scene with one fails at that element.
         read_depths(p, st);
+        d.type = IntegratorType::Path;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
+    if (type == "prb" || type == "prbvolpath" || type == "prb_projective") {
+        // Mitsuba's differentiable path tracers (Python, ad/integrators/). Their primal image is
+        // the path tracer's: emitter sampling and BSDF sampling combined by MIS, Russian roulette
+        // on the throughput times eta^2 from rr_depth. Only their default depth differs (6).
+        read_depths(p, st, 6);
+        if (type == "prb_projective") read_projective(p);
+        d.type = IntegratorType::Path;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
+    if (type == "prb_basic") {
+        // The differentiable path tracer without emitter sampling: BSDF-sampled paths only, so
+        // point, spot and directional lights contribute nothing, exactly as in Mitsuba.
+        read_depths(p, st, 6);
+        d.type = IntegratorType::Path;
+        st.sampling = SamplingMode::Bsdf;
+        d.hide_emitters = p.get_bool("hide_emitters", false);
+        p.report_unused();
+        return IntegratorRole::Renders;
+    }
+    if (type == "direct_projective") {
+        // Direct illumination by the path tracer's estimator: Mitsuba reads max_depth and rr_depth
+        // (checked here the same way) and then fixes the depth at 2 segments, one scattering event.
+        read_depths(p, st, 6);
+        read_projective(p);
+        st.max_depth = 1;
         d.type = IntegratorType::Path;
         d.hide_emitters = p.get_bool("hide_emitters", false);
         p.report_unused();
@@ -141,7 +189,8 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov)");
+                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov, "
+                "prb, prb_basic, prbvolpath, prb_projective, direct_projective)");
 }
 
 FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {
