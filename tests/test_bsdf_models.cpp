@@ -62,6 +62,13 @@ PlasticBsdf plastic(float alpha, vec3 rho = vec3(0.5f)) {
     p.diffuse_reflectance = rho;
     return p;
 }
+PPlasticBsdf pplastic(float alpha, vec3 rho = vec3(0.3f, 0.5f, 0.7f)) {
+    PPlasticBsdf p;
+    p.distribution = MicrofacetType::GGX;
+    p.alpha_u = p.alpha_v = alpha;
+    p.diffuse_reflectance = rho;
+    return p;
+}
 
 // Incident cosines: near normal, 60 degrees, 81 degrees and 87.7 degrees (grazing). The chi-square's
 // expected counts come from Simpson's rule per cell, which loses accuracy where a narrow lobe or
@@ -73,6 +80,7 @@ float roughness(const Bsdf& b) {
     if (auto* c = std::get_if<ConductorBsdf>(&b)) return std::min(c->alpha_u, c->alpha_v);
     if (auto* d = std::get_if<DielectricBsdf>(&b)) return std::min(d->alpha_u, d->alpha_v);
     if (auto* p = std::get_if<PlasticBsdf>(&b)) return p->alpha;
+    if (auto* p = std::get_if<PPlasticBsdf>(&b)) return std::min(p->alpha_u, p->alpha_v);
     return 1.f;
 }
 
@@ -118,6 +126,11 @@ std::vector<Case> chi2_cases() {
     PlasticBsdf bp = plastic(0.3f);
     bp.distribution = B;
     add("beckmann roughplastic a0.3", bp, false);
+    for (float a : {0.1f, 0.3f, 0.6f}) add("pplastic a" + std::to_string(a).substr(0, 4), pplastic(a), false);
+    add("beckmann pplastic a0.3", aniso(pplastic(0.f), B, 0.3f, 0.3f), false);
+    add("ggx pplastic au0.4 av0.1", aniso(pplastic(0.f), G, 0.4f, 0.1f), false);
+    // Mostly specular (a dark base): the glossy lobe is chosen 3 times in 4.
+    add("pplastic dark a0.2", pplastic(0.2f, vec3(0.3f, 0.3f, 0.4f) / 3.f), false);
     return cs;
 }
 
@@ -381,6 +394,7 @@ TEST(BsdfConsistency, Reciprocity) {
         {"conductor", gold(0.3f)},          {"roughplastic", prepared(plastic(0.25f))},
         {"plastic", prepared(plastic(0.f))}, {"roughglass", glass(0.3f)},
         {"roughdiamond", glass(0.15f, 2.42f)},
+        {"pplastic", pplastic(0.25f)},
     };
     auto rand_dir = [&]() {
         float a = rng.next_float();
@@ -435,6 +449,7 @@ TEST(BsdfFurnace, AlbedoAtMostOne) {
         bsdfs.push_back({"white plastic a" + s, prepared(plastic(a, vec3(1.f)))});
         bsdfs.push_back({"glass a" + s, glass(a)});
         bsdfs.push_back({"diamond a" + s, glass(a, 2.42f)});
+        bsdfs.push_back({"white pplastic a" + s, pplastic(a, vec3(1.f))});
     }
     const int m = int(bsdfs.size()) * 5 * 2;
     // One-sided: the albedo exceeds 1 only if its z against 1 is beyond the Sidak-corrected level.

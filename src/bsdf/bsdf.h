@@ -21,6 +21,7 @@
 #include "bsdf/dielectric.h"
 #include "bsdf/diffuse.h"
 #include "bsdf/plastic.h"
+#include "bsdf/pplastic.h"
 #include "bsdf/principled.h"
 #include "bsdf/thindielectric.h"
 #include "texture/texture.h"
@@ -34,8 +35,10 @@ namespace candela {
 //   DielectricBsdf  glass, smooth (alpha 0) or rough             (`dielectric`, `roughdielectric`)
 //   ThinDielectricBsdf  a thin pane: reflection + straight through (`thindielectric`)
 //   PrincipledBsdf  Burley's principled model as Mitsuba 3.9 has it (`principled`)
+//   PPlasticBsdf    rough specular plus refracted Lambertian, added (`pplastic`, unpolarised)
 // docs/materials.md describes each model and its tests.
-using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf, PrincipledBsdf>;
+using Bsdf = std::variant<DiffuseBsdf, ConductorBsdf, PlasticBsdf, DielectricBsdf, ThinDielectricBsdf, PrincipledBsdf,
+                          PPlasticBsdf>;
 
 // Dispatch that knows only the diffuse BSDF, as a diffuse-only renderer would have it; any other
 // BSDF renders black. Used in two places: the whole dispatch of the yardstick build for issue 6
@@ -123,7 +126,9 @@ inline void prepare(Bsdf& b) {
 inline bool is_anisotropic(const Bsdf& b) {
     return std::visit([](const auto& x) {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, ConductorBsdf> || std::is_same_v<T, DielectricBsdf>) return x.alpha_u != x.alpha_v;
+        if constexpr (std::is_same_v<T, ConductorBsdf> || std::is_same_v<T, DielectricBsdf> ||
+                      std::is_same_v<T, PPlasticBsdf>)
+            return x.alpha_u != x.alpha_v;
         else if constexpr (std::is_same_v<T, PrincipledBsdf>) return x.anisotropic > 0.f;
         else return false;
     }, b);

@@ -116,6 +116,7 @@ bool edit_bsdf(PrincipledBsdf& b) {
 }
 
 const char* model_name(const PrincipledBsdf&) { return "principled"; }
+const char* model_name(const PPlasticBsdf&) { return "pplastic"; }
 
 // Model names, recognised by their parameters as well (the variant may grow).
 template <class T>

@@ -26,6 +26,10 @@ BSDFS = [
     '<float name="alpha_v" value="0.4"/><float name="int_ior" value="1.33"/></bsdf>',
     '<bsdf type="roughplastic"><float name="alpha" value="0.2"/>'
     '<rgb name="diffuse_reflectance" value="0.2 0.5 0.8"/></bsdf>',
+    '<bsdf type="pplastic"><rgb name="diffuse_reflectance" value="0.05 0.3 0.6"/><float name="alpha" value="0.15"/></bsdf>',
+    '<bsdf type="pplastic"><string name="distribution" value="ggx"/><float name="alpha_u" value="0.4"/>'
+    '<float name="alpha_v" value="0.1"/><float name="int_ior" value="1.7"/>'
+    '<rgb name="specular_reflectance" value="0.9 0.8 0.7"/></bsdf>',
 ]
 
 

@@ -213,6 +213,27 @@ Material make_roughplastic(XmlLoader& L, Object& o) {
     return with_textures(L, o, Material{"", p, false}, {kPlasticTextures[0], kPlasticTextures[1]});
 }
 
+// Mitsuba's pplastic: the plastic's IORs and reflectances, a microfacet roughness that may be
+// anisotropic (but not textured: Mitsuba reads it as a float), no `nonlinear`.
+Material make_pplastic(XmlLoader& L, Object& o) {
+    PPlasticBsdf p;
+    p.int_ior = ior_param(o, "int_ior", 1.49f);
+    p.ext_ior = ior_param(o, "ext_ior", 1.000277f);
+    if (p.int_ior == p.ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
+    p.diffuse_reflectance = nonnegative_rgb(o, "diffuse_reflectance", vec3(0.5f));
+    p.specular_reflectance = nonnegative_rgb(o, "specular_reflectance", vec3(1.f));
+    for (const char* n : {"alpha", "alpha_u", "alpha_v"})
+        if (has_texture_named(o, n, L))
+            throw L.error(o.node, std::string("a texture for '") + n + "': pplastic's roughness is a number");
+    const MicrofacetParams mp = microfacet_params(L, o, true);
+    p.distribution = mp.type;
+    p.alpha_u = mp.alpha_u;
+    p.alpha_v = mp.alpha_v;
+    return with_textures(L, o, Material{"", p, false},
+                         {{"diffuse_reflectance", set_field<PPlasticBsdf, &PPlasticBsdf::diffuse_reflectance>},
+                          {"specular_reflectance", set_field<PPlasticBsdf, &PPlasticBsdf::specular_reflectance>}});
+}
+
 DielectricBsdf dielectric_params(Object& o) {
     DielectricBsdf d;
     d.int_ior = ior_param(o, "int_ior", 1.5046f);
@@ -338,6 +359,7 @@ const PluginTable<BsdfFactory>& bsdf_plugins() {
         {"roughconductor", make_roughconductor},
         {"plastic", make_plastic},
         {"roughplastic", make_roughplastic},
+        {"pplastic", make_pplastic},
         {"dielectric", make_dielectric},
         {"roughdielectric", make_roughdielectric},
         {"thindielectric", make_thindielectric},
