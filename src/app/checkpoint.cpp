@@ -171,6 +171,16 @@ std::string hex(uint64_t v) {
 
 }  // namespace
 
+// A curve segment's other end and place (nothing for the other kinds: their fingerprints stay).
+void hash_curve(Hasher& h, const AnalyticShape& a) {
+    if (a.kind != PrimKind::Curve) return;
+    h.v3(a.p1);
+    h.f32(a.radius1);
+    h.u64(a.segment);
+    h.u64(a.segments);
+    h.u64(a.start_cap);
+}
+
 uint64_t scene_fingerprint(const Scene& scene) {
     Hasher h;
     h.str("candela scene fingerprint 1");
@@ -252,6 +262,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
             h.bytes(&a.to_world, sizeof(a.to_world));
             h.v3(a.normal);
             h.f32(a.area);
+            hash_curve(h, a);
         }
         for (const Shape& s : scene.shapes) h.i64(s.analytic);
     }
@@ -281,6 +292,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
                 h.f32(a.radius);
                 h.f32(a.length);
                 h.bytes(&a.to_world, sizeof(a.to_world));
+                hash_curve(h, a);
             }
         }
         h.u64(scene.instances.size());

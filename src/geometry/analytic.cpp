@@ -61,6 +61,82 @@ void to_object(const AnalyticShape& s, const Ray& ray, dvec3& o, dvec3& d) {
     d = dmat3(s.to_object) * dvec3(ray.d);
 }
 
+// The entering hit of a linear curve segment (geometry/analytic.h): the first entry into its end
+// sphere(s) or into the lateral cone between them, whichever comes first. The earliest entry into one
+// of these convex pieces is the entry into their union, so overlaps (the cone and the spheres, and
+// neighbouring segments at a joint) need no special case; the joint's sphere is tested once, by the
+// segment that ends there. Solved in double around the foot of the
+// ray on the segment's midpoint; the point returned is p - p0, reprojected onto the sphere of the
+// v found (v in [0, 1]: 0 and 1 on the caps).
+bool curve_hit(const AnalyticShape& s, const Ray& ray, double& t_out, dvec3& q_out, double& v_out) {
+    const dvec3 a(s.center), b(s.p1), d(ray.d);
+    const double ra = s.radius, rb = s.radius1;
+    const double dd = glm::dot(d, d);
+    if (!(dd > 0.0)) return false;
+    const dvec3 o0(ray.o);
+    const double ts = glm::dot(0.5 * (a + b) - o0, d) / dd;
+    const dvec3 oa = o0 + ts * d - a;  // the shifted origin, relative to p0
+    const double tmin = double(ray.tmin) - ts;
+    double best = double(ray.tmax) - ts, v_best = 0.0;
+    bool found = false;
+    auto sphere = [&](dvec3 c_rel, double r, double v) {
+        if (!(r > 0.0)) return;
+        double t0, t1;
+        if (!solve_from_foot(oa - c_rel, d, r, t0, t1)) return;
+        if (t0 > tmin && t0 < best) best = t0, v_best = v, found = true;  // entering root only
+    };
+    if (s.start_cap) sphere(dvec3(0.0), ra, 0.0);  // else the previous segment's end sphere
+    sphere(b - a, rb, 1.0);
+    const dvec3 ba = b - a;
+    const double L = glm::length(ba);
+    if (L > std::abs(ra - rb)) {
+        // The lateral surface: rho(z) = A + B z around the axis w, z measured from p0; the sphere of
+        // parameter v touches it at z = k ra + v L (1 - k^2), k = (ra - rb) / L.
+        const dvec3 w = ba / L;
+        const double k = (ra - rb) / L, s2 = 1.0 - k * k, sq = std::sqrt(s2);
+        const double A = ra / sq, B = -k / sq;
+        const double oz = glm::dot(oa, w), dz = glm::dot(d, w), c0 = A + B * oz;
+        const double qa = dd - dz * dz * (1.0 + B * B);
+        const double qb = glm::dot(oa, d) - oz * dz - B * dz * c0;  // half the linear coefficient
+        const double qc = glm::dot(oa, oa) - oz * oz - c0 * c0;
+        double roots[2];
+        int n = 0;
+        if (std::abs(qa) > 1e-12 * dd) {
+            const double disc = qb * qb - qa * qc;
+            if (disc >= 0.0) {
+                const double q = -(qb + std::copysign(std::sqrt(disc), qb));
+                roots[0] = q / qa;
+                roots[1] = q != 0.0 ? qc / q : roots[0];
+                if (roots[0] > roots[1]) std::swap(roots[0], roots[1]);
+                n = 2;
+            }
+        } else if (qb != 0.0) {
+            roots[0] = -qc / (2.0 * qb);
+            n = 1;
+        }
+        const double z0 = k * ra, span = L * s2;
+        for (int i = 0; i < n; ++i) {
+            const double t = roots[i];
+            if (!(t > tmin && t < best)) continue;
+            const dvec3 p = oa + t * d;
+            const double z = glm::dot(p, w);
+            if (!(z >= z0 && z <= z0 + span)) continue;
+            const double v = (z - z0) / span;
+            if (glm::dot(p - v * ba, d) >= 0.0) continue;  // leaving the surface: culled
+            best = t, v_best = v, found = true;
+            break;
+        }
+    }
+    if (!found) return false;
+    t_out = best + ts;
+    if (!(t_out > double(ray.tmin) && t_out < double(ray.tmax))) return false;
+    const dvec3 c_rel = v_best * ba, p = oa + best * d - c_rel;
+    const double l = glm::length(p);
+    q_out = l > 0.0 ? c_rel + p * ((ra + v_best * (rb - ra)) / l) : c_rel + p;
+    v_out = v_best;
+    return true;
+}
+
 // The closest valid t of the shape in (tmin, tmax), and its refined local point.
 bool find_hit(const AnalyticShape& s, const Ray& ray, double& t, dvec3& local) {
     const double tmin = ray.tmin, tmax = ray.tmax;
@@ -106,6 +182,10 @@ bool find_hit(const AnalyticShape& s, const Ray& ray, double& t, dvec3& local) {
                 return true;
             }
             return false;
+        }
+        case PrimKind::Curve: {
+            double v;
+            return curve_hit(s, ray, t, local, v);
         }
         case PrimKind::Triangle: break;
     }
@@ -170,6 +250,9 @@ AABB AnalyticShape::bounds() const {
             box = AABB(glm::min(p0, p1) - x, glm::max(p0, p1) + x);
             break;
         }
+        case PrimKind::Curve:
+            box = AABB(glm::min(center - vec3(radius), p1 - vec3(radius1)), glm::max(center + vec3(radius), p1 + vec3(radius1)));
+            break;
         case PrimKind::Triangle: break;
     }
     // Rounding of the corners must not cut off the surface.
@@ -261,14 +344,35 @@ AnalyticShape make_cylinder(const mat4& to_world, vec3 p0, vec3 p1, float radius
     return s;
 }
 
+AnalyticShape make_curve_segment(vec3 p0, float r0, vec3 p1, float r1, uint32_t segment, uint32_t segments,
+                                 bool start_cap) {
+    if (!all_finite(p0) || !all_finite(p1) || !std::isfinite(r0) || !std::isfinite(r1) || r0 < 0.f || r1 < 0.f)
+        throw Error("a curve's control point or radius is not finite, or a radius is negative");
+    AnalyticShape s;
+    s.kind = PrimKind::Curve;
+    s.center = p0;
+    s.radius = r0;
+    s.p1 = p1;
+    s.radius1 = r1;
+    s.segment = segment;
+    s.segments = segments;
+    s.start_cap = start_cap;
+    // The lateral area of the cone (slant length times the mean circumference); the caps are shared
+    // with the neighbours. Only reported (curves take no emitter).
+    const float L = glm::length(p1 - p0);
+    s.area = kPi * (r0 + r1) * std::sqrt(std::max(0.f, L * L - (r0 - r1) * (r0 - r1)));
+    return s;
+}
+
 bool intersect_analytic(const AnalyticShape& s, Ray& ray, Hit& hit) {
-    double t;
+    double t, v = 0.0;
     dvec3 local;
-    if (!find_hit(s, ray, t, local)) return false;
+    if (s.kind == PrimKind::Curve ? !curve_hit(s, ray, t, local, v) : !find_hit(s, ray, t, local)) return false;
     hit.t = float(t);
     hit.kind = s.kind;
     hit.local = vec3(local);
-    hit.b1 = hit.b2 = 0.f;
+    hit.b1 = float(v);
+    hit.b2 = 0.f;
     ray.tmax = hit.t;
     return true;
 }
@@ -331,6 +435,29 @@ SurfaceInteraction analytic_interaction(const AnalyticShape& s, const Hit& hit) 
             }
             break;
         }
+        case PrimKind::Curve: {
+            si.p = s.center + q;
+            si.p_error = sphere_point_error(q, si.p);
+            const vec3 ba = s.p1 - s.center, c_rel = hit.b1 * ba;
+            vec3 n = q - c_rel;
+            const float nl = glm::length(n);
+            n = nl > 0.f ? n / nl : vec3(0.f, 0.f, 1.f);
+            si.ng = si.ns = n;
+            // Mitsuba's local_frame: v_rot is +z made orthogonal to the axis ((0, 1, 0) when they are
+            // parallel), v_rad = v_rot x axis; u is the angle of n from v_rad towards v_rot.
+            const vec3 axis = glm::normalize(ba);
+            const vec3 guide(0.f, 0.f, 1.f);
+            vec3 v_rot = std::abs(glm::dot(guide, axis)) == 1.f ? vec3(0.f, 1.f, 0.f)
+                                                                 : glm::normalize(guide - axis * glm::dot(axis, guide));
+            const vec3 v_rad = glm::cross(v_rot, axis);
+            si.uv = vec2(float(wrap_phi(glm::dot(v_rot, n), glm::dot(v_rad, n)) / (2.0 * 3.14159265358979323846)),
+                         (hit.b1 + float(s.segment)) / float(s.segments));
+            // Mitsuba 3.9.1 leaves dp/du and dp/dv of curves zero (measured), so that its shading
+            // frame, and with it an anisotropic lobe, is Frame(n); candela does the same. (Its later
+            // sources set dp/du = 2 pi axis x (p - c) and the frame from it.)
+            si.dpdu = si.dpdv = vec3(0.f);
+            break;
+        }
         case PrimKind::Triangle: break;
     }
     return si;
@@ -383,6 +510,7 @@ bool sample_analytic(const AnalyticShape& s, vec3 ref_p, vec2 u, AnalyticSample&
             out.n = cylinder_normal(s, q);
             break;
         }
+        case PrimKind::Curve:  // the loader gives curves no emitter
         case PrimKind::Triangle: return false;
     }
     out.pdf = area_pdf_to_solid_angle(s.area, ref_p, out.p, out.n);

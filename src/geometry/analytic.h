@@ -10,6 +10,17 @@
 //             uv = (r, phi / 2pi) of the object-space point.
 //   cylinder  the side (no caps) x^2 + y^2 = r^2, 0 <= z <= length of a rigid object frame; normal
 //             outwards; uv = (phi / 2pi, z / length).
+//   curve     one segment of Mitsuba's `linearcurve` (Embree's round linear curve): the volume
+//             swept by a sphere whose centre c(v) = p0 + v (p1 - p0) and radius r(v) = r0 + v (r1 - r0)
+//             run over v in [0, 1], i.e. a cone tangent to two end spheres. As in Embree, a joint's
+//             sphere belongs to the segment that ends there (v = 1), and a segment has its start
+//             sphere only when it starts its curve (start_cap). Only the surface's
+//             entering side is hit (a ray from inside sees nothing, as Embree culls it). The normal
+//             is p - c(v) for the v whose sphere touches p (v = 0, 1 on the end caps). Mitsuba's
+//             parameterisation: u = the angle around the axis in the frame of its local_frame
+//             (guide +z) over 2 pi, v = (segment + v) / segments of the whole shape; dp/du and
+//             dp/dv zero, as Mitsuba 3.9.1 has them (its shading frame is then Frame(n)).
+//             Curves take no emitter and no flip_normals (Mitsuba ignores it on curves).
 // flip_normals turns every normal (geometric and shading) around, and with it the side an area
 // emitter on the shape lights.
 //
@@ -35,6 +46,12 @@ struct AnalyticShape {
     glm::dmat4 to_object{1.0};
     vec3 normal{0.f, 0.f, 1.f};  // disk: world normal (flip applied)
     float area = 0.f;    // world surface area
+    // curve: center and radius are p0 and r0; these the other end and the segment's place in its
+    // shape (for uv.v).
+    vec3 p1{0.f};
+    float radius1 = 0.f;
+    uint32_t segment = 0, segments = 1;
+    bool start_cap = true;  // the sphere at p0 belongs to this segment: it starts its curve
 
     AABB bounds() const;
 };
@@ -47,10 +64,15 @@ struct AnalyticShape {
 AnalyticShape make_sphere(const mat4& to_world, vec3 center, float radius, bool flip);
 AnalyticShape make_disk(const mat4& to_world, bool flip);
 AnalyticShape make_cylinder(const mat4& to_world, vec3 p0, vec3 p1, float radius, bool flip);
+// A linear curve segment in world space (the caller has applied to_world to the points; the radii
+// are not transformed, as in Mitsuba). segment < segments; start_cap for the first of a curve.
+AnalyticShape make_curve_segment(vec3 p0, float r0, vec3 p1, float r1, uint32_t segment, uint32_t segments,
+                                 bool start_cap = true);
 
 // Closest intersection with ray.tmin < t < ray.tmax (the ray direction need not be unit). On a hit
 // sets hit.t (shrinks ray.tmax to it), hit.kind and hit.local (the point refined onto the surface:
-// sphere p - c in world axes, disk and cylinder object space); the caller sets hit.prim.
+// sphere p - c and curve p - p0 in world axes, disk and cylinder object space; a curve's v in
+// hit.b1); the caller sets hit.prim.
 bool intersect_analytic(const AnalyticShape& s, Ray& ray, Hit& hit);
 bool occluded_analytic(const AnalyticShape& s, const Ray& ray);
 

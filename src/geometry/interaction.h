@@ -5,7 +5,7 @@
 namespace candela {
 
 // The kinds of primitive an accelerator reports (geometry/analytic.h for the analytic ones).
-enum class PrimKind : uint32_t { Triangle = 0, Sphere, Disk, Cylinder };
+enum class PrimKind : uint32_t { Triangle = 0, Sphere, Disk, Cylinder, Curve };
 
 // What an accelerator reports: the closest primitive and where on it. A triangle's surface point
 // is rebuilt from the barycentrics (not o + t d), which keeps its error small and bounded; an

@@ -86,7 +86,8 @@ struct Shape {
     bool has_color() const { return color_offset != kNone; }
     uint32_t first_triangle = 0;
     uint32_t triangle_count = 0;
-    int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder (no triangles)
+    int32_t analytic = -1;     // index into Geometry::analytic for a sphere, disk or cylinder, or the first
+                               // segment of a linearcurve (no triangles)
     // Index into Geometry::groups for a shape of a shapegroup: first_triangle and analytic then
     // index the group's mesh and shapes, and the shape is only seen through instances.
     int32_t group = -1;

@@ -44,6 +44,20 @@ uint32_t SceneDescription::add_shape(const std::string& name, const std::vector<
     return shape_index;
 }
 
+uint32_t SceneDescription::add_analytic_shapes(const std::string& name, std::vector<AnalyticShape> parts,
+                                               uint32_t material) {
+    Shape s;
+    s.name = name;
+    s.material = material;
+    s.first_triangle = uint32_t(mesh.triangles.size());
+    s.analytic = int32_t(analytic.size());  // the first part; Shape::analytic of a curve
+    const uint32_t index = uint32_t(shapes.size());
+    for (AnalyticShape& a : parts) a.shape = index;
+    analytic.insert(analytic.end(), parts.begin(), parts.end());
+    shapes.push_back(s);
+    return index;
+}
+
 uint32_t SceneDescription::add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material,
                                               int32_t emitter) {
     Shape s;

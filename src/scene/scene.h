@@ -76,6 +76,8 @@ struct SceneDescription {
                        const std::vector<vec2>& uvs = {}, const std::vector<vec3>& colors = {});
     // Appends an analytic shape (world space, see geometry/analytic.h). Returns its shape index.
     uint32_t add_analytic_shape(const std::string& name, AnalyticShape a, uint32_t material, int32_t emitter);
+    // Appends one shape made of several analytic primitives (a curve's segments), without emitter.
+    uint32_t add_analytic_shapes(const std::string& name, std::vector<AnalyticShape> parts, uint32_t material);
 };
 
 // The immutable geometry, shared by every Scene built from one description.

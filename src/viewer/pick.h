@@ -15,7 +15,7 @@ struct PickResult {
     uint32_t triangle = ~0u;              // the triangle hit, ~0u on an analytic shape (in an
                                           // instance: the triangle of its group's mesh)
     uint32_t instance = ~0u;              // the instance hit (Scene::instances), ~0u outside them
-    PrimKind kind = PrimKind::Triangle;   // what was hit: a triangle, or a sphere, disk or cylinder
+    PrimKind kind = PrimKind::Triangle;   // what was hit: a triangle, or a sphere, disk, cylinder or curve segment
     vec2 uv{0.f};                         // analytic shapes: Mitsuba's (u, v) there
     int32_t emitter = -1;
 };

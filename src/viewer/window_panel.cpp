@@ -261,7 +261,7 @@ void Viewer::panel_pick() {
     }
     const Shape& shape = fe_->scene().shapes[pick.shape];
     ImGui::Text("object  %s", shape.name.c_str());
-    static const char* const kKinds[] = {"triangle", "sphere", "disk", "cylinder"};
+    static const char* const kKinds[] = {"triangle", "sphere", "disk", "cylinder", "curve segment"};
     if (pick.kind == PrimKind::Triangle) ImGui::Text("triangle  %u", pick.triangle);
     else ImGui::Text("%s  uv %.4f %.4f", kKinds[int(pick.kind)], pick.uv.x, pick.uv.y);
     if (pick.instance != ~0u)

@@ -53,10 +53,13 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
                 for (int k = 0; k < 3; ++k) *o++ = si.dpdv[k];
                 break;
             case AovType::PrimIndex: {
-                // Mitsuba's prim_index: the triangle within its mesh; an analytic shape is one primitive.
-                // (A group's shape counts its first_triangle in the group's mesh, as hit.prim does.)
+                // Mitsuba's prim_index: the triangle within its mesh, the segment within its curve; the
+                // other analytic shapes are one primitive. (A group's shape counts its first_triangle
+                // in the group's mesh, as hit.prim does.)
                 const Shape& shape = scene.shapes[si.shape];
-                *o++ = hit.kind == PrimKind::Triangle ? float(hit.prim - shape.first_triangle) : 0.f;
+                *o++ = hit.kind == PrimKind::Triangle ? float(hit.prim - shape.first_triangle)
+                       : hit.kind == PrimKind::Curve  ? float(hit.prim - uint32_t(shape.analytic))
+                                                      : 0.f;
                 break;
             }
             case AovType::ShapeIndex: *o++ = float(si.shape); break;

@@ -6,6 +6,7 @@
 #include "scene/obj.h"
 #include "scene/shapes_analytic.h"
 #include "scene/xml/plugins.h"
+#include "shapes/curve_file.h"
 #include "shapes/mesh_file.h"
 
 namespace candela {
@@ -141,13 +142,52 @@ const PluginTable<ShapeFactory>& shape_plugins() {
     return table;
 }
 
+// Mitsuba's linearcurve (geometry/analytic.h): the control points of the file under to_world
+// (the radii unchanged), one analytic segment per pair of consecutive points of a curve.
+void load_linearcurve(XmlLoader& L, pugi::xml_node n, Object& o) {
+    ++L.shape_counter;
+    const std::string full = mesh_file_path(L, o, "curve");
+    const mat4 m = o.params.get_transform("to_world", mat4(1.f));
+    o.params.get_bool("flip_normals", false);  // Mitsuba's curves ignore it
+    CurveFile f;
+    try {
+        f = read_curve_file(full);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
+    }
+    const uint32_t material = L.material_for(o);
+    for (Nested& c : o.nested) {
+        const bool ref = c.tag == "ref" && L.object_by_id(c.node, L.required_attr(c.node, "id"), "").tag == "emitter";
+        if (c.tag == "emitter" || ref)
+            throw L.error(c.node, "a linearcurve cannot be an area emitter (Mitsuba cannot sample points on curves either)");
+    }
+    L.finish(o);
+    std::vector<vec3> world(f.points.size());
+    for (size_t i = 0; i < f.points.size(); ++i) world[i] = vec3(m * glm::vec4(f.points[i], 1.f));
+    std::vector<AnalyticShape> segments;
+    const uint32_t count = uint32_t(f.points.size() - f.starts.size());
+    segments.reserve(count);
+    for (size_t c = 0; c < f.starts.size(); ++c) {
+        const uint32_t end = c + 1 < f.starts.size() ? f.starts[c + 1] : uint32_t(f.points.size());
+        for (uint32_t i = f.starts[c]; i + 1 < end; ++i) {
+            if (!all_finite(world[i]) || !all_finite(world[i + 1]))
+                throw o.params.error("to_world", "a control point is not finite under to_world");
+            segments.push_back(make_curve_segment(world[i], f.radii[i], world[i + 1], f.radii[i + 1],
+                                                  uint32_t(segments.size()), count, i == f.starts[c]));
+        }
+    }
+    const std::string name = n.attribute("id") ? L.attr(n, "id") : o.params.get_string("filename", o.type);
+    L.scene().add_analytic_shapes(name, segments, material);
+}
+
 void load_shape(XmlLoader& L, pugi::xml_node n) {
     Object o = L.read_object(n, "shape");
     if (o.type == "shapegroup") return load_shapegroup(L, o);
     if (o.type == "instance") return load_instance(L, o);
+    if (o.type == "linearcurve") return load_linearcurve(L, n, o);
     const bool analytic = is_analytic_shape_type(o.type);  // intersected exactly, not tessellated
     ShapeFactory make =
-        analytic ? nullptr : L.find_plugin(shape_plugins(), o, ", sphere, disk, cylinder, shapegroup, instance");
+        analytic ? nullptr : L.find_plugin(shape_plugins(), o, ", sphere, disk, cylinder, linearcurve, shapegroup, instance");
     ++L.shape_counter;
     mat4 m = o.params.get_transform("to_world", mat4(1.f));
     bool flip = o.params.get_bool("flip_normals", false);
