@@ -6,7 +6,8 @@
 // The image tests compare candela with committed Mitsuba 3.9.1 references of the Cornell box at
 // 32 x 32 (path tracing, Mitsuba max_depth 3) with each filter, made by
 //   $PY tests/data/make_reference.py tests/data/scenes/cbox_filter.xml --res 32 --batches 16
-//       --spp 2048 --variant scalar_rgb -D filter=F --out tests/data/filter_F     (F = box, tent, gaussian)
+//       --spp 2048 --variant scalar_rgb -D filter=F --out tests/data/filter_F
+//   (F = box, tent, gaussian, mitchell, catmullrom, lanczos)
 // (scalar_rgb: Mitsuba's scalar image block uses the discretised filter, as candela does). The
 // control: the box-filtered image must be rejected against the gaussian reference (the Cornell
 // box's edges and light make the blur visible).
@@ -64,6 +65,37 @@ TEST(Filters, MitsubaDefinitionsAndDiscretisation) {
     EXPECT_EQ(PixelFilter(gaussian_filter(1.f)).reach(), 4);
 }
 
+// The filters with negative lobes against Mitsuba 3.9.1's own eval and eval_discretized (printed by
+// mi.load_dict({'type': 'mitchell', ...}).eval(x) in scalar_rgb).
+TEST(Filters, NegativeLobedFiltersMatchMitsubasValues) {
+    struct Row {
+        FilterDesc desc;
+        float radius;
+        float at[6];  // eval at 0, 0.3, 0.9, 1.4, 1.99, 2.5
+        float disc[2];  // eval_discretized at 0.3, 1.4
+    };
+    const Row rows[] = {
+        {mitchell_filter(), 2.f, {0.88888896f, 0.74038899f, 0.11938893f, -0.035999898f, -3.2797383e-05f, 0.f},
+         {0.77574509f, -0.034312934f}},
+        {mitchell_filter(0.2f, 0.4f), 2.f, {0.93333334f, 0.77043331f, 0.099033192f, -0.050400402f, -3.995611e-05f, 0.f},
+         {0.8091616f, -0.050127298f}},
+        {catmullrom_filter(), 2.f, {1.f, 0.81550002f, 0.068499967f, -0.072000027f, -4.9273174e-05f, 0.f},
+         {0.85928643f, -0.073847935f}},
+        {lanczos_filter(), 3.f, {1.f, 0.84434313f, 0.09381593f, -0.14668514f, -0.0021004691f, 0.024317075f},
+         {0.8537122f, -0.1469572f}},
+        {lanczos_filter(2), 2.f, {1.f, 0.82697457f, 0.076356769f, -0.079549633f, -2.5246434e-05f, 0.f},
+         {0.86971271f, -0.084112875f}},
+    };
+    const float xs[6] = {0.f, 0.3f, 0.9f, 1.4f, 1.99f, 2.5f};
+    for (const Row& r : rows) {
+        const PixelFilter f(r.desc);
+        EXPECT_EQ(f.radius(), r.radius) << filter_name(r.desc.type);
+        for (int i = 0; i < 6; ++i) EXPECT_NEAR(f.eval(xs[i]), r.at[i], 2e-6f) << filter_name(r.desc.type) << " at " << xs[i];
+        EXPECT_NEAR(f.eval_discretized(0.3f), r.disc[0], 2e-6f) << filter_name(r.desc.type);
+        EXPECT_NEAR(f.eval_discretized(1.4f), r.disc[1], 2e-6f) << filter_name(r.desc.type);
+    }
+}
+
 TEST(Filters, OneSampleSplatsMitsubasWeights) {
     Film film(8, 8);
     film.set_layout(true, 0);
@@ -89,7 +121,7 @@ TEST(Filters, OneSampleSplatsMitsubasWeights) {
 }
 
 TEST(Filters, EachFilterMatchesMitsuba) {
-    for (const char* f : {"box", "tent", "gaussian"}) {
+    for (const char* f : {"box", "tent", "gaussian", "mitchell", "catmullrom", "lanczos"}) {
         ImageEstimate ref = load_reference(std::string("filter_") + f);
         ImageEstimate test = render_batches(f, 8, 128);
         BlockTestResult r = block_z_test(test, ref, 4, kAlpha);
@@ -223,7 +255,17 @@ TEST(Filters, XmlParametersDefaultsAndErrors) {
             EXPECT_NE(std::string(e.what()).find("scene.xml:"), std::string::npos) << e.what();
         }
     };
-    expect_error("<rfilter type=\"mitchell\"/>", "unsupported rfilter type 'mitchell'");
+    EXPECT_EQ(load("<rfilter type=\"mitchell\"/>").settings.filter, mitchell_filter());
+    EXPECT_EQ(load("<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.5\"/><float name=\"C\" value=\"0.25\"/></rfilter>")
+                  .settings.filter,
+              mitchell_filter(0.5f, 0.25f));
+    EXPECT_EQ(load("<rfilter type=\"catmullrom\"/>").settings.filter, catmullrom_filter());
+    EXPECT_EQ(load("<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"2\"/></rfilter>").settings.filter,
+              lanczos_filter(2));
+    expect_error("<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"0\"/></rfilter>", "lobes");
+    expect_error("<rfilter type=\"mitchell\"><float name=\"B\" value=\"1e30\"/></rfilter>", "B must be finite");
+    expect_error("<rfilter type=\"catmullrom\"><float name=\"C\" value=\"0.5\"/></rfilter>", "C");
+    expect_error("<rfilter type=\"blackman\"/>", "unsupported rfilter type 'blackman'");
     expect_error("<rfilter type=\"box\"><float name=\"radius\" value=\"1\"/></rfilter>", "radius");
     expect_error("<rfilter type=\"tent\"><float name=\"radius\" value=\"-1\"/></rfilter>", "radius");
     expect_error("<rfilter type=\"tent\"><float name=\"radius\" value=\"nan\"/></rfilter>", "radius");

@@ -215,6 +215,10 @@ uint64_t scene_fingerprint(const Scene& scene) {
         h.i64(int(st.filter.type));
         h.f32(st.filter.radius);
         h.f32(st.filter.stddev);
+        if (st.filter.type == FilterType::Mitchell) {  // the other types keep their fingerprints
+            h.f32(st.filter.b);
+            h.f32(st.filter.c);
+        }
     }
     h.str(scene.accel ? scene.accel->name() : std::string());
 

@@ -13,24 +13,32 @@
 
 namespace candela {
 
-enum class FilterType { Box, Tent, Gaussian };
+enum class FilterType { Box, Tent, Gaussian, Mitchell, CatmullRom, Lanczos };
 
 // What the scene file asks for. Box has radius 0.5 (Mitsuba's box takes no parameters); tent's
-// radius defaults to 1; gaussian's stddev to 0.5, with radius 4 stddev.
+// radius defaults to 1; gaussian's stddev to 0.5, with radius 4 stddev. Mitchell-Netravali (B, C
+// default 1/3) and Catmull-Rom (B = 0, C = 1/2) are the cubic family of radius 2; Lanczos is
+// sinc(x) sinc(x / lobes) over |x| <= lobes (default 3). The last three have negative lobes:
+// a pixel's value stays sum(w L) / sum(w), as in Mitsuba.
 struct FilterDesc {
     FilterType type = FilterType::Box;
-    float radius = 0.5f;  // tent: the radius; gaussian: derived (4 stddev); box: 0.5
+    float radius = 0.5f;  // tent: the radius; gaussian: derived (4 stddev); box: 0.5; cubics: 2;
+                          // lanczos: the number of lobes
     float stddev = 0.5f;  // gaussian only
+    float b = 1.f / 3.f, c = 1.f / 3.f;  // mitchell (catmullrom: 0 and 0.5)
     bool is_box() const { return type == FilterType::Box; }
 };
 inline bool operator==(const FilterDesc& a, const FilterDesc& b) {
-    return a.type == b.type && a.radius == b.radius && a.stddev == b.stddev;
+    return a.type == b.type && a.radius == b.radius && a.stddev == b.stddev && a.b == b.b && a.c == b.c;
 }
 inline bool operator!=(const FilterDesc& a, const FilterDesc& b) { return !(a == b); }
 
 FilterDesc box_filter();
 FilterDesc tent_filter(float radius = 1.f);
 FilterDesc gaussian_filter(float stddev = 0.5f);
+FilterDesc mitchell_filter(float b = 1.f / 3.f, float c = 1.f / 3.f);
+FilterDesc catmullrom_filter();
+FilterDesc lanczos_filter(int lobes = 3);
 const char* filter_name(FilterType t);
 
 // The filter ready for splatting.

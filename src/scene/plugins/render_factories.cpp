@@ -1,4 +1,5 @@
 #include "scene/plugins/render_factories.h"
+#include <cmath>
 #include <sstream>
 
 namespace candela {
@@ -206,9 +207,20 @@ FilterDesc read_rfilter(const std::string& type, const ParamSet& p, int line) {
         float s = p.get_float("stddev", 0.5f);
         if (!(s > 0.f && s <= 16.f)) throw p.error("stddev", "gaussian stddev must be in (0, 16] pixels");
         f = 4.f * s == 0.5f ? box_filter() : gaussian_filter(s);
+    } else if (type == "mitchell") {
+        const float b = p.get_float("B", 1.f / 3.f), c = p.get_float("C", 1.f / 3.f);
+        if (!std::isfinite(b) || std::abs(b) > 16.f) throw p.error("B", "B must be finite (|B| <= 16)");
+        if (!std::isfinite(c) || std::abs(c) > 16.f) throw p.error("C", "C must be finite (|C| <= 16)");
+        f = mitchell_filter(b, c);
+    } else if (type == "catmullrom") {
+        f = catmullrom_filter();
+    } else if (type == "lanczos") {
+        const int lobes = p.get_int("lobes", 3);
+        if (lobes < 1 || lobes > 64) throw p.error("lobes", "lanczos lobes must be in [1, 64]");
+        f = lanczos_filter(lobes);
     } else {
         throw Error(p.file(), line, "unsupported rfilter type '" + type +
-                    "' (candela supports: box, tent, gaussian)");
+                    "' (candela supports: box, tent, gaussian, mitchell, catmullrom, lanczos)");
     }
     p.report_unused();
     return f;
