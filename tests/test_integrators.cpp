@@ -378,6 +378,9 @@ TEST(IntegratorXml, ParametersAndErrors) {
              "<integrator type=\"volpath\"><integer name=\"max_depth\" value=\"2\"/></integrator></integrator></integrator>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
     EXPECT_EQ(s.settings.max_depth, 1);
+    s = load("<integrator type=\"volpathmis\"><integer name=\"max_depth\" value=\"4\"/></integrator>");
+    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
+    EXPECT_EQ(s.settings.max_depth, 3);
     // The moment channels come last, named after the (unnamed: "_arg_0") integrator it holds.
     ASSERT_EQ(s.settings.integrator.aovs.size(), 2u);
     EXPECT_EQ(aov_channel_names(s.settings.integrator.aovs),

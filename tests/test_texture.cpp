@@ -7,6 +7,7 @@
 #include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include "core/error.h"
+#include "support/bsdf_xml.h"
 #include "support/run.h"
 #include "film/film.h"
 #include "film/image_io.h"
@@ -405,4 +406,72 @@ TEST(Texture, UnsupportedTextureParametersAreErrors) {
     expect_error("<bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\">\n"
                  "<string name=\"name\" value=\"face_color\"/></texture></bsdf>\n",
                  "not supported (only vertex_color)");
+}
+
+// Mitsuba's constant spectra as textures (srgb, d65, uniform, rawconstant) give the colours Mitsuba
+// 3.9.1's scalar_rgb evaluates them to (srgb and d65: their colour, d65 times its scale, uniform and
+// rawconstant: their value), folded into the BSDF's or emitter's value: nothing stays textured.
+TEST(Texture, ConstantSpectraFoldIntoValues) {
+    auto albedo = [](const std::string& tex) {
+        const Material m = test::load_bsdf_material("texture-constants", "c",
+                                                    "<bsdf type=\"diffuse\">" + tex + "</bsdf>");
+        EXPECT_FALSE(m.textured());
+        return std::get<DiffuseBsdf>(m.bsdf).albedo;
+    };
+    EXPECT_EQ(albedo("<texture type=\"srgb\" name=\"reflectance\"><rgb name=\"color\" value=\"0.5, 0.2, 0.1\"/></texture>"),
+              vec3(0.5f, 0.2f, 0.1f));
+    EXPECT_EQ(albedo("<texture type=\"d65\" name=\"reflectance\"><rgb name=\"color\" value=\"0.5, 0.2, 0.1\"/>"
+                     "<float name=\"scale\" value=\"0.5\"/></texture>"),
+              vec3(0.25f, 0.1f, 0.05f));
+    EXPECT_EQ(albedo("<texture type=\"uniform\" name=\"reflectance\"><float name=\"value\" value=\"0.25\"/></texture>"),
+              vec3(0.25f));
+    EXPECT_EQ(albedo("<texture type=\"rawconstant\" name=\"reflectance\"><float name=\"value\" value=\"0.3\"/></texture>"),
+              vec3(0.3f));
+    // A float parameter takes the constant's value (a roughness here).
+    const Material rc = test::load_bsdf_material(
+        "texture-constants", "alpha",
+        "<bsdf type=\"roughconductor\"><texture type=\"uniform\" name=\"alpha\"><float name=\"value\" value=\"0.3\"/></texture></bsdf>");
+    EXPECT_FALSE(rc.textured());
+    EXPECT_FLOAT_EQ(std::get<ConductorBsdf>(rc.bsdf).alpha_u, 0.3f);
+    // Inside a checkerboard, as one of its colours.
+    const Material cb = test::load_bsdf_material(
+        "texture-constants", "checker",
+        "<bsdf type=\"diffuse\"><texture type=\"checkerboard\" name=\"reflectance\"><texture type=\"srgb\" name=\"color0\">"
+        "<rgb name=\"color\" value=\"0.9, 0.1, 0.1\"/></texture></texture></bsdf>");
+    ASSERT_TRUE(cb.textured());
+    TextureQuery q;
+    q.uv = vec2(0.25f, 0.25f);
+    EXPECT_EQ(cb.textures[0].texture->eval(q), vec3(0.9f, 0.1f, 0.1f));
+    // Emitters: constant, area and point strengths.
+    const std::string d = test::temp_dir("texture-constant-emitters");
+    test::write_text(d + "/e.xml",
+                     "<scene version=\"3.0.0\">\n<emitter type=\"constant\"><texture type=\"d65\" name=\"radiance\">"
+                     "<float name=\"scale\" value=\"0.5\"/></texture></emitter>\n"
+                     "<shape type=\"sphere\"><emitter type=\"area\"><texture type=\"srgb\" name=\"radiance\">"
+                     "<rgb name=\"color\" value=\"2, 1, 1\"/><boolean name=\"unbounded\" value=\"true\"/></texture></emitter></shape>\n"
+                     "</scene>\n");
+    const SceneDescription s = load_scene(d + "/e.xml");
+    ASSERT_EQ(s.emitters.size(), 1u);
+    EXPECT_EQ(s.emitters[0].radiance, vec3(2.f, 1.f, 1.f));
+    EXPECT_FALSE(s.emitters[0].texture);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(std::get<ConstantLight>(s.lights[0].model).radiance, vec3(0.5f));
+    // Refusals: a reflectance above 1 unless unbounded, a missing colour, a varying texture where
+    // only a value is taken.
+    EXPECT_NE(test::load_bsdf_error("texture-constants", "bad", "<bsdf type=\"diffuse\">\n<texture type=\"srgb\" "
+                                                                "name=\"reflectance\"><rgb name=\"color\" value=\"1.5, 0, 0\"/></texture></bsdf>")
+                  .find("must be in [0, 1]"),
+              std::string::npos);
+    EXPECT_NE(test::load_bsdf_error("texture-constants", "nocolor", "<bsdf type=\"diffuse\">\n<texture type=\"srgb\" "
+                                                                    "name=\"reflectance\"/></bsdf>")
+                  .find("srgb needs a 'color'"),
+              std::string::npos);
+    test::write_text(d + "/v.xml", "<scene version=\"3.0.0\">\n<emitter type=\"constant\"><texture type=\"checkerboard\" "
+                                   "name=\"radiance\"/></emitter>\n</scene>\n");
+    try {
+        load_scene(d + "/v.xml");
+        ADD_FAILURE() << "a checkerboard radiance on a constant emitter was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("v.xml:2: a varying texture for 'radiance'"), std::string::npos) << e.what();
+    }
 }

@@ -79,9 +79,9 @@ void read_projective(const ParamSet& p) {
 
 IntegratorRole read_integrator(const std::string& type, const ParamSet& p, RenderSettings& st, int line) {
     IntegratorDesc& d = st.integrator;
-    if (type == "path" || type == "volpath") {
-        // volpath is the path tracer in a scene without media; candela reads no <medium>, so a
-        // scene with one fails at that element.
+    if (type == "path" || type == "volpath" || type == "volpathmis") {
+        // volpath (and volpathmis, its spectral-MIS variant) is the path tracer in a scene without
+        // media; candela reads no <medium>, so a scene with one fails at that element.
         read_depths(p, st);
         d.type = IntegratorType::Path;
         d.hide_emitters = p.get_bool("hide_emitters", false);
@@ -190,7 +190,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         return IntegratorRole::Wraps;
     }
     throw Error(p.file(), line, "unsupported integrator type '" + type +
-                "' (candela supports: path, volpath, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov, "
+                "' (candela supports: path, volpath, volpathmis, direct, ptracer, bdpt, pssmlt, mmlt, moment, aov, "
                 "prb, prb_basic, prbvolpath, prb_projective, direct_projective)");
 }
 

@@ -30,6 +30,14 @@ Material with_textures(XmlLoader& L, Object& o, Material m, std::initializer_lis
         if (auto t = nested_texture(L, o, p.name)) {
             if (o.params.has(p.name)) throw o.params.error(p.name, std::string("'") + p.name + "' is given both as a value and as a texture");
             const bool scalar = p.scalar || std::string(p.name).rfind("alpha", 0) == 0;  // a float parameter
+            // A constant (srgb, d65, uniform, rawconstant) is folded into the BSDF's value: the
+            // material stays untextured and costs nothing per hit.
+            if (const ConstantTexture* c = std::get_if<ConstantTexture>(&t->v)) {
+                if (!all_finite(c->value) || !(min_component(c->value) >= 0.f))
+                    throw L.error(o.node, std::string("'") + p.name + "' must be finite and not negative");
+                p.apply(m.bsdf, scalar ? vec3(luminance(c->value)) : c->value);
+                continue;
+            }
             m.textures.push_back(TextureSlot{scalar ? as_float_texture(t) : t, p.apply, p.name});
         }
     for (const Nested& c : o.nested)

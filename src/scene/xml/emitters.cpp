@@ -9,7 +9,17 @@ namespace xml {
 
 namespace {
 
-vec3 strength(Object& e, const char* name) {
+// A value, or a nested texture that is a constant (srgb, d65, uniform, rawconstant): folded into the
+// value, since these emitters take no spatially varying strength.
+vec3 strength(XmlLoader& L, Object& e, const char* name) {
+    if (std::shared_ptr<const Texture> t = nested_texture(L, e, name)) {
+        if (e.params.has(name)) throw e.params.error(name, std::string("'") + name + "' is given both as a value and as a texture");
+        const ConstantTexture* c = std::get_if<ConstantTexture>(&t->v);
+        if (!c) throw L.error(e.node, std::string("a varying texture for '") + name + "' is not supported by " + e.what());
+        if (!all_finite(c->value) || !(min_component(c->value) >= 0.f))
+            throw L.error(e.node, std::string(name) + " must be finite and not negative");
+        return c->value;
+    }
     vec3 v = e.params.get_rgb(name, vec3(1.f));
     if (!all_finite(v) || !(min_component(v) >= 0.f))
         throw e.params.error(name, std::string(name) + " must be finite and not negative");
@@ -27,7 +37,13 @@ vec3 transformed_z(Object& e, const mat4& m) {
 EmitterModel make_area(XmlLoader& L, Object& e) {
     // A textured radiance (bitmap, checkerboard): evaluated at the uv of each emitting point.
     std::shared_ptr<const Texture> t = nested_texture(L, e, "radiance");
-    if (!t) return AreaEmitter{strength(e, "radiance"), nullptr};
+    if (!t) return AreaEmitter{strength(L, e, "radiance"), nullptr};
+    if (const ConstantTexture* c = std::get_if<ConstantTexture>(&t->v)) {  // d65, srgb...: a plain value
+        if (e.params.has("radiance")) throw e.params.error("radiance", "'radiance' is given both as a value and as a texture");
+        if (!all_finite(c->value) || !(min_component(c->value) >= 0.f))
+            throw L.error(e.node, "radiance must be finite and not negative");
+        return AreaEmitter{c->value, nullptr};
+    }
     if (e.params.has("radiance")) throw e.params.error("radiance", "'radiance' is given both as a value and as a texture");
     if (t->uses_vertex_colors())
         throw L.error(e.node, "a radiance texture that reads vertex colours (mesh_attribute) is not supported");
@@ -36,7 +52,7 @@ EmitterModel make_area(XmlLoader& L, Object& e) {
 
 EmitterModel make_point(XmlLoader& L, Object& e) {
     PointLight l;
-    l.intensity = strength(e, "intensity");
+    l.intensity = strength(L, e, "intensity");
     if (e.params.has("position") && e.params.has("to_world"))
         throw L.error(e.node, "point: only one of 'position' and 'to_world' may be given");
     l.position = e.params.get_point("position", vec3(0.f));
@@ -47,7 +63,7 @@ EmitterModel make_point(XmlLoader& L, Object& e) {
 
 EmitterModel make_spot(XmlLoader& L, Object& e) {
     SpotLight l;
-    l.intensity = strength(e, "intensity");
+    l.intensity = strength(L, e, "intensity");
     l.to_world = e.params.get_transform("to_world", mat4(1.f));
     l.cutoff_angle = e.params.get_float("cutoff_angle", 20.f);
     if (!(l.cutoff_angle > 0.f && l.cutoff_angle <= 90.f))
@@ -65,7 +81,7 @@ EmitterModel make_spot(XmlLoader& L, Object& e) {
 
 EmitterModel make_directional(XmlLoader& L, Object& e) {
     DirectionalLight l;
-    l.irradiance = strength(e, "irradiance");
+    l.irradiance = strength(L, e, "irradiance");
     if (e.params.has("direction") && e.params.has("to_world"))
         throw L.error(e.node, "directional: only one of 'direction' and 'to_world' may be given");
     if (e.params.has("direction")) {
@@ -79,8 +95,8 @@ EmitterModel make_directional(XmlLoader& L, Object& e) {
     return l;
 }
 
-EmitterModel make_constant(XmlLoader&, Object& e) {
-    return ConstantLight{strength(e, "radiance")};
+EmitterModel make_constant(XmlLoader& L, Object& e) {
+    return ConstantLight{strength(L, e, "radiance")};
 }
 
 EmitterModel make_envmap(XmlLoader& L, Object& e) {

@@ -1,5 +1,5 @@
 // The texture family of the XML reader: Mitsuba 3's `bitmap`, `checkerboard` and
-// `mesh_attribute`, as nested elements of the plugins that take them or as top-level elements
+// `mesh_attribute`, and the constant spectra `srgb`, `d65`, `uniform`, `rawconstant`, as nested elements of the plugins that take them or as top-level elements
 // referenced by id.
 #include "scene/xml/plugins.h"
 
@@ -51,6 +51,38 @@ Texture make_mesh_attribute(XmlLoader&, Object& o) {
     return Texture{t};
 }
 
+// Mitsuba's constant spectra, which its RGB variants evaluate as these colours (measured with
+// 3.9.1's scalar_rgb: srgb and d65 give their colour, d65 times its scale, uniform and rawconstant
+// their value).
+Texture make_srgb(XmlLoader& L, Object& o) {
+    if (!o.params.has("color")) throw L.error(o.node, "srgb needs a 'color'");
+    const vec3 c = o.params.get_rgb("color", vec3(0.f));
+    const bool unbounded = o.params.get_bool("unbounded", false);
+    if (!all_finite(c) || (!unbounded && !(min_component(c) >= 0.f && max_component(c) <= 1.f)))
+        throw o.params.error("color", unbounded ? "color must be finite"
+                                                : "a reflectance color must be in [0, 1] (set 'unbounded' for others)");
+    return constant_texture(c);
+}
+
+Texture make_d65(XmlLoader&, Object& o) {
+    const vec3 c = o.params.get_rgb("color", vec3(1.f)) * o.params.get_float("scale", 1.f);
+    if (!all_finite(c) || !(min_component(c) >= 0.f)) throw o.params.error("color", "d65 color x scale must be finite and >= 0");
+    return constant_texture(c);
+}
+
+Texture make_uniform(XmlLoader&, Object& o) {
+    const float v = o.params.get_float("value", 1.f);
+    if (!std::isfinite(v)) throw o.params.error("value", "value must be finite");
+    return constant_texture(vec3(v));
+}
+
+Texture make_rawconstant(XmlLoader& L, Object& o) {
+    if (!o.params.has("value")) throw L.error(o.node, "rawconstant needs a 'value'");
+    const vec3 c = o.params.get_rgb("value", vec3(0.f));
+    if (!all_finite(c)) throw o.params.error("value", "value must be finite");
+    return constant_texture(c);
+}
+
 }  // namespace
 
 const PluginTable<TextureFactory>& texture_plugins() {
@@ -58,6 +90,10 @@ const PluginTable<TextureFactory>& texture_plugins() {
         {"bitmap", make_bitmap},
         {"checkerboard", make_checkerboard},
         {"mesh_attribute", make_mesh_attribute},
+        {"srgb", make_srgb},
+        {"d65", make_d65},
+        {"uniform", make_uniform},
+        {"rawconstant", make_rawconstant},
     };
     return table;
 }
