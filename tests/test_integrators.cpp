@@ -378,15 +378,15 @@ TEST(IntegratorXml, ParametersAndErrors) {
              "<integrator type=\"volpath\"><integer name=\"max_depth\" value=\"2\"/></integrator></integrator></integrator>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
     EXPECT_EQ(s.settings.max_depth, 1);
-    s = load("<integrator type=\"volpathmis\"><integer name=\"max_depth\" value=\"4\"/></integrator>");
-    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
-    EXPECT_EQ(s.settings.max_depth, 3);
     // The moment channels come last, named after the (unnamed: "_arg_0") integrator it holds.
     ASSERT_EQ(s.settings.integrator.aovs.size(), 2u);
     EXPECT_EQ(aov_channel_names(s.settings.integrator.aovs),
               (std::vector<std::string>{"d.T", "_arg_0.X", "_arg_0.Y", "_arg_0.Z", "m2__arg_0.X", "m2__arg_0.Y",
                                         "m2__arg_0.Z"}));
 
+    s = load("<integrator type=\"volpathmis\"><integer name=\"max_depth\" value=\"4\"/></integrator>");
+    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
+    EXPECT_EQ(s.settings.max_depth, 3);
     // The differentiable integrators: Mitsuba's default depth for them is 6 segments, not unbounded.
     s = load("<integrator type=\"prb\"/>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
