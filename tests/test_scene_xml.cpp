@@ -415,8 +415,8 @@ TEST(SceneXml, Errors) {
     expect_error("<shape type=\"rectangle\">\n<bsdf type=\"twosided\"/></shape>\n", 3, "needs a nested <bsdf>");
     expect_error("<integrator type=\"sppm\"/>\n", 2, "unsupported integrator type 'sppm'");
     expect_error("<emitter type=\"sunsky\"/>\n", 2, "unsupported emitter type 'sunsky'");  // constant is supported now
-    expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\">\n<rfilter type=\"mitchell\"/></film></sensor>\n", 4,
-                 "unsupported rfilter type 'mitchell'");
+    expect_error("<sensor type=\"perspective\">\n<film type=\"hdrfilm\">\n<rfilter type=\"blackman\"/></film></sensor>\n", 4,
+                 "unsupported rfilter type 'blackman'");
     expect_error("<sensor type=\"perspective\">\n<float name=\"fov\" value=\"abc\"/></sensor>\n", 3, "could not parse float 'abc'");
     expect_error("<sensor type=\"perspective\">\n<string name=\"fov\" value=\"40\"/></sensor>\n", 3, "must be <float>, not <string>");
     expect_error("<integrator type=\"path\">\n<float name=\"max_depth\" value=\"3\"/></integrator>\n", 3, "must be <integer>");
