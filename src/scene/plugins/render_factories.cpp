@@ -88,33 +88,18 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         p.report_unused();
         return IntegratorRole::Renders;
     }
-    if (type == "prb" || type == "prbvolpath" || type == "prb_projective") {
-        // Mitsuba's differentiable path tracers (Python, ad/integrators/). Their primal image is
-        // the path tracer's: emitter sampling and BSDF sampling combined by MIS, Russian roulette
-        // on the throughput times eta^2 from rr_depth. Only their default depth differs (6).
+    if (type == "prb" || type == "prbvolpath" || type == "prb_projective" || type == "prb_basic" ||
+        type == "direct_projective") {
+        // Mitsuba's differentiable integrators (Python, ad/integrators/), read for their primal
+        // image, which is the path tracer's: emitter and BSDF sampling combined by MIS, Russian
+        // roulette on the throughput times eta^2 from rr_depth, and Mitsuba's default depth for
+        // them (6, not unbounded). prb_basic samples the BSDF only (so point, spot and directional
+        // lights contribute nothing, as in Mitsuba); direct_projective reads max_depth and rr_depth
+        // (checked the same way) and then fixes the depth at 2 segments, one scattering event.
         read_depths(p, st, 6);
-        if (type == "prb_projective") read_projective(p);
-        d.type = IntegratorType::Path;
-        d.hide_emitters = p.get_bool("hide_emitters", false);
-        p.report_unused();
-        return IntegratorRole::Renders;
-    }
-    if (type == "prb_basic") {
-        // The differentiable path tracer without emitter sampling: BSDF-sampled paths only, so
-        // point, spot and directional lights contribute nothing, exactly as in Mitsuba.
-        read_depths(p, st, 6);
-        d.type = IntegratorType::Path;
-        st.sampling = SamplingMode::Bsdf;
-        d.hide_emitters = p.get_bool("hide_emitters", false);
-        p.report_unused();
-        return IntegratorRole::Renders;
-    }
-    if (type == "direct_projective") {
-        // Direct illumination by the path tracer's estimator: Mitsuba reads max_depth and rr_depth
-        // (checked here the same way) and then fixes the depth at 2 segments, one scattering event.
-        read_depths(p, st, 6);
-        read_projective(p);
-        st.max_depth = 1;
+        if (type == "prb_projective" || type == "direct_projective") read_projective(p);
+        if (type == "prb_basic") st.sampling = SamplingMode::Bsdf;
+        if (type == "direct_projective") st.max_depth = 1;
         d.type = IntegratorType::Path;
         d.hide_emitters = p.get_bool("hide_emitters", false);
         p.report_unused();

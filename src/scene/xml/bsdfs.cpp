@@ -73,6 +73,13 @@ float ior_param(Object& o, const std::string& name, float def) {
     return v;
 }
 
+// int_ior (default int_default) and ext_ior (default air), which must differ (an interface).
+void read_distinct_iors(Object& o, float int_default, float& int_ior, float& ext_ior) {
+    int_ior = ior_param(o, "int_ior", int_default);
+    ext_ior = ior_param(o, "ext_ior", 1.000277f);
+    if (int_ior == ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
+}
+
 vec3 nonnegative_rgb(Object& o, const std::string& name, vec3 def) {
     vec3 v = o.params.get_rgb(name, def);
     if (!(min_component(v) >= 0.f)) throw o.params.error(name, name + " must not be negative");
@@ -225,9 +232,7 @@ Material make_roughplastic(XmlLoader& L, Object& o) {
 // anisotropic (but not textured: Mitsuba reads it as a float), no `nonlinear`.
 Material make_pplastic(XmlLoader& L, Object& o) {
     PPlasticBsdf p;
-    p.int_ior = ior_param(o, "int_ior", 1.49f);
-    p.ext_ior = ior_param(o, "ext_ior", 1.000277f);
-    if (p.int_ior == p.ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
+    read_distinct_iors(o, 1.49f, p.int_ior, p.ext_ior);
     p.diffuse_reflectance = nonnegative_rgb(o, "diffuse_reflectance", vec3(0.5f));
     p.specular_reflectance = nonnegative_rgb(o, "specular_reflectance", vec3(1.f));
     for (const char* n : {"alpha", "alpha_u", "alpha_v"})
@@ -244,9 +249,7 @@ Material make_pplastic(XmlLoader& L, Object& o) {
 
 DielectricBsdf dielectric_params(Object& o) {
     DielectricBsdf d;
-    d.int_ior = ior_param(o, "int_ior", 1.5046f);
-    d.ext_ior = ior_param(o, "ext_ior", 1.000277f);
-    if (d.int_ior == d.ext_ior) throw o.params.error("int_ior", "int_ior and ext_ior must differ");
+    read_distinct_iors(o, 1.5046f, d.int_ior, d.ext_ior);
     d.specular_reflectance = nonnegative_rgb(o, "specular_reflectance", vec3(1.f));
     d.specular_transmittance = nonnegative_rgb(o, "specular_transmittance", vec3(1.f));
     return d;
