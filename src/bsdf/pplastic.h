@@ -38,40 +38,44 @@ struct PPlasticBsdf {
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode) const {
         if (wo.z <= 0.f || wi.z <= 0.f) return vec3(0.f);
-        const float e = eta();
-        const vec3 m = glm::normalize(wo + wi);
-        const Microfacet mf = microfacet();
-        const float glossy = mf.D(m) * mf.G(wo, wi, m) / (4.f * wo.z);
-        vec3 f = specular_reflectance * (fresnel_dielectric(glm::dot(wo, m), e).F * glossy);
-        const float t = (1.f - fresnel_dielectric(wo.z, e).F) * (1.f - fresnel_dielectric(wi.z, e).F);
-        return f + diffuse_reflectance * (t * wi.z * kInvPi);
+        return eval_pdf(wo, wi).first;
     }
 
     float pdf(vec3 wo, vec3 wi, TransportMode) const {
         if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
-        const vec3 m = glm::normalize(wo + wi);
-        float glossy = 0.f;
-        if (glm::dot(wo, m) > 0.f && glm::dot(wi, m) > 0.f) {
-            // Visible normals: D_wo(m) / (4 wo.m) = D(m) G1(wo, m) / (4 cos theta_o).
-            const Microfacet mf = microfacet();
-            glossy = mf.D(m) * mf.G1(wo, m) / (4.f * wo.z);
-        }
-        const float ps = specular_probability();
-        return ps * glossy + (1.f - ps) * square_to_cosine_hemisphere_pdf(wi);
+        return eval_pdf(wo, wi).second;
     }
 
-    std::optional<BsdfSample> sample(vec3 wo, float u1, vec2 u2, TransportMode mode) const {
+    std::optional<BsdfSample> sample(vec3 wo, float u1, vec2 u2, TransportMode) const {
         if (wo.z <= 0.f) return std::nullopt;
         BsdfSample s;
         s.wi = u1 < specular_probability() ? reflect(wo, microfacet().sample_visible(wo, u2))
                                            : square_to_cosine_hemisphere(u2);
         if (s.wi.z <= 0.f) return std::nullopt;  // reflected below the surface
-        s.pdf = pdf(wo, s.wi, mode);
-        if (!(s.pdf > 0.f)) return std::nullopt;
-        s.f = eval(wo, s.wi, mode);
+        const auto [f, p] = eval_pdf(wo, s.wi);
+        if (!(p > 0.f)) return std::nullopt;
+        s.f = f;
+        s.pdf = p;
         return s;
     }
     bool has_smooth_component() const { return true; }
+
+private:
+    // f cos theta_i and the mixture pdf from one half vector and one D(m) (wo.z, wi.z > 0).
+    std::pair<vec3, float> eval_pdf(vec3 wo, vec3 wi) const {
+        const float e = eta();
+        const vec3 m = glm::normalize(wo + wi);
+        const Microfacet mf = microfacet();
+        const float D = mf.D(m), g1o = mf.G1(wo, m);
+        const float glossy = D * g1o * mf.G1(wi, m) / (4.f * wo.z);
+        const vec3 f = specular_reflectance * (fresnel_dielectric(glm::dot(wo, m), e).F * glossy);
+        const float t = (1.f - fresnel_dielectric(wo.z, e).F) * (1.f - fresnel_dielectric(wi.z, e).F);
+        // Visible normals: D_wo(m) / (4 wo.m) = D(m) G1(wo, m) / (4 cos theta_o).
+        const float p_glossy = glm::dot(wo, m) > 0.f && glm::dot(wi, m) > 0.f ? D * g1o / (4.f * wo.z) : 0.f;
+        const float ps = specular_probability();
+        return {f + diffuse_reflectance * (t * wi.z * kInvPi),
+                ps * p_glossy + (1.f - ps) * square_to_cosine_hemisphere_pdf(wi)};
+    }
 };
 
 }  // namespace candela
