@@ -189,10 +189,14 @@ vec3 Bdpt::sample(S& sampler, ivec2 px, Workspace& ws, SplatTile& out, PathStats
     covered = nc > 1 && ws.cam[1].kind == BdptVertex::Kind::Surface;
     const int nl = light_subpath(sampler, ws, max_light, stats);
 
-    // Every strategy, in a fixed order (the sampler's dimensions follow it).
+    // Every strategy, in a fixed order (the sampler's dimensions follow it). s = 1 takes a fresh light
+    // sample, so it is tried whenever the scene has lights, even when the light subpath failed (its
+    // emission sample was black, e.g. a dark texel of a textured spot or projector): skipping it
+    // there lost those paths' next-event estimates while MIS still counted on them.
+    const int s_max = std::max(nl, sc.lights.empty() ? 0 : 1);
     vec3 L(0.f);
     for (int t = 1; t <= nc; ++t)
-        for (int s = 0; s <= nl; ++s) {
+        for (int s = 0; s <= s_max; ++s) {
             const int depth = s + t - 2;
             if ((s == 1 && t == 1) || depth < 0 || (max_depth >= 0 && depth > max_depth)) continue;
             if (depth == 0 && st.integrator.hide_emitters) continue;
