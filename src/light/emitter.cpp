@@ -62,9 +62,58 @@ vec3 SpotLight::profile(vec3 d) const {
     return v;
 }
 
+bool ProjectorLight::uv_of(vec3 d, vec2& uv) const {
+    if (!(d.z > 0.f)) return false;
+    uv = vec2(0.5f - 0.5f * d.x / (d.z * tan_x), 0.5f - 0.5f * d.y / (d.z * tan_y));
+    return uv.x >= 0.f && uv.x <= 1.f && uv.y >= 0.f && uv.y <= 1.f;  // closed, as Mitsuba's test
+}
+
+vec3 ProjectorLight::direction_of(vec2 uv) const {
+    return glm::normalize(vec3((1.f - 2.f * uv.x) * tan_x, (1.f - 2.f * uv.y) * tan_y, 1.f));
+}
+
+// The texture's mean over a grid of cells (its texels when it is a plain bitmap, else 64 x 64),
+// each cell given the largest value of its 3 x 3 neighbourhood (bilinear filtering spreads a texel
+// into its neighbours' cells), mixed 9:1 with a uniform density so that no uv that can give light
+// has density 0, whatever the texture (a checkerboard's edges, wrapped borders).
+void ProjectorLight::build_density() {
+    int nu = 64, nv = 64;
+    if (const BitmapTexture* b = std::get_if<BitmapTexture>(&irradiance->v);
+        b && b->to_uv.m == glm::mat3(1.f) && b->texels->width <= 2048 && b->texels->height <= 2048) {
+        nu = b->texels->width;
+        nv = b->texels->height;
+    } else if (irradiance->is_constant()) {
+        nu = nv = 1;
+    }
+    std::vector<float> f(size_t(nu) * size_t(nv));
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            TextureQuery q;
+            q.uv = vec2((float(i) + 0.5f) / float(nu), (float(j) + 0.5f) / float(nv));
+            const vec3 c = glm::max(irradiance->eval(q), vec3(0.f));
+            const float m = (c.x + c.y + c.z) / 3.f;
+            f[size_t(j) * size_t(nu) + size_t(i)] = std::isfinite(m) ? m : 0.f;
+        }
+    std::vector<float> w(f.size());
+    double sum = 0.0;
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            float m = 0.f;
+            for (int y = std::max(j - 1, 0); y <= std::min(j + 1, nv - 1); ++y)
+                for (int x = std::max(i - 1, 0); x <= std::min(i + 1, nu - 1); ++x)
+                    m = std::max(m, f[size_t(y) * size_t(nu) + size_t(x)]);
+            w[size_t(j) * size_t(nu) + size_t(i)] = m;
+            sum += double(m);
+        }
+    const double mean = sum / double(w.size());
+    for (float& x : w) x = mean > 0.0 ? float(0.9 * double(x) / mean + 0.1) : 1.f;
+    density = std::make_shared<const Distribution2D>(w, nu, nv);
+}
+
 uint32_t light_flags(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return uint32_t(kLightDeltaPosition); },
                                  [](const SpotLight&) { return uint32_t(kLightDeltaPosition); },
+                                 [](const ProjectorLight&) { return uint32_t(kLightDeltaPosition); },
                                  [](const DirectionalLight&) { return uint32_t(kLightDeltaDirection | kLightInfinite); },
                                  [](const ConstantLight&) { return uint32_t(kLightInfinite); },
                                  [](const EnvmapLight&) { return uint32_t(kLightInfinite); }},
@@ -73,6 +122,7 @@ uint32_t light_flags(const LightModel& m) {
 
 const char* light_type_name(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return "point"; }, [](const SpotLight&) { return "spot"; },
+                                 [](const ProjectorLight&) { return "projector"; },
                                  [](const DirectionalLight&) { return "directional"; },
                                  [](const ConstantLight&) { return "constant"; },
                                  [](const EnvmapLight&) { return "envmap"; }},
@@ -82,6 +132,7 @@ const char* light_type_name(const LightModel& m) {
 vec3& light_strength(LightModel& m) {
     return std::visit(overloaded{[](PointLight& l) -> vec3& { return l.intensity; },
                                  [](SpotLight& l) -> vec3& { return l.intensity; },
+                                 [](ProjectorLight& l) -> vec3& { return l.scale; },
                                  [](DirectionalLight& l) -> vec3& { return l.irradiance; },
                                  [](ConstantLight& l) -> vec3& { return l.radiance; },
                                  [](EnvmapLight& l) -> vec3& { return l.scale; }},
@@ -91,6 +142,7 @@ vec3 light_strength(const LightModel& m) { return light_strength(const_cast<Ligh
 
 const char* light_strength_name(const LightModel& m) {
     return std::visit(overloaded{[](const PointLight&) { return "intensity"; }, [](const SpotLight&) { return "intensity"; },
+                                 [](const ProjectorLight&) { return "scale"; },
                                  [](const DirectionalLight&) { return "irradiance"; },
                                  [](const ConstantLight&) { return "radiance"; },
                                  [](const EnvmapLight&) { return "scale"; }},
@@ -105,6 +157,11 @@ bool same_light(const Light& a, const Light& b) {
                        const SpotLight& o = std::get<SpotLight>(b.model);
                        return l.to_world == o.to_world && l.cutoff_angle == o.cutoff_angle &&
                               l.beam_width == o.beam_width && l.texture == o.texture;
+                   },
+                   [&](const ProjectorLight& l) {
+                       const ProjectorLight& o = std::get<ProjectorLight>(b.model);
+                       return l.to_world == o.to_world && l.irradiance == o.irradiance && l.tan_x == o.tan_x &&
+                              l.tan_y == o.tan_y;
                    },
                    [&](const DirectionalLight& l) { return l.direction == std::get<DirectionalLight>(b.model).direction; },
                    [&](const ConstantLight&) { return true; },
@@ -147,6 +204,32 @@ bool sample_li(const LightModel& m, const SceneSphere& sphere, vec3 ref_p, vec2 
                 out.p_error = vec3(0.f);
                 out.n = vec3(0.f);
                 out.Le = l.intensity * prof / d2;
+                out.pdf = 1.f;
+                out.delta = true;
+                out.infinite = false;
+                return true;
+            },
+            [&](const ProjectorLight& l) {
+                const vec3 pos = l.position();
+                const vec3 d = pos - ref_p;
+                const float d2 = glm::dot(d, d);
+                if (!(d2 > 0.f)) return false;
+                out.dist = std::sqrt(d2);
+                out.wi = d / out.dist;
+                const vec3 local = l.to_local(ref_p - pos);
+                vec2 uv;
+                if (!l.uv_of(local, uv)) return false;
+                // Mitsuba's sample_direction: pi scale E(uv) / (z^2 cos), z the reference point's depth
+                // along the axis and cos the angle to it (= pi scale E / cos^3 / dist^2).
+                const float cos_axis = -glm::dot(l.to_world_dir(vec3(0.f, 0.f, 1.f)), out.wi);
+                if (!(cos_axis > 0.f)) return false;
+                TextureQuery q;
+                q.uv = uv;
+                out.Le = kPi * l.scale * l.irradiance->eval(q) / (local.z * local.z * cos_axis);
+                if (is_black(out.Le) || !all_finite(out.Le)) return false;
+                out.p = pos;
+                out.p_error = vec3(0.f);
+                out.n = vec3(0.f);
                 out.pdf = 1.f;
                 out.delta = true;
                 out.infinite = false;
@@ -228,6 +311,21 @@ std::optional<EmissionSample> sample_le(const LightModel& m, const SceneSphere& 
                        es.pdf_dir = square_to_uniform_cone_pdf(local, cos_cutoff);
                        return es.pdf_dir > 0.f;
                    },
+                   [&](const ProjectorLight& l) {
+                       vec2 uv;
+                       float pdf_uv;
+                       if (!l.density || !l.density->sample(u_dir, uv, pdf_uv)) return false;
+                       const vec3 d = l.direction_of(uv);
+                       const float c3 = d.z * d.z * d.z;
+                       TextureQuery q;
+                       q.uv = uv;
+                       es.ray.o = l.position();
+                       es.ray.d = glm::normalize(l.to_world_dir(d));
+                       es.Le = kPi * l.scale * l.irradiance->eval(q) / c3;
+                       es.pdf_pos = 1.f;
+                       es.pdf_dir = pdf_uv / (l.image_area() * c3);
+                       return std::isfinite(es.pdf_dir) && es.pdf_dir > 0.f && all_finite(es.Le);
+                   },
                    [&](const DirectionalLight& l) {
                        // From the disk facing the light, one radius before the centre.
                        es.ray.o = disk_point(sphere, -l.direction, u_pos) - sphere.radius * l.direction;
@@ -277,6 +375,15 @@ void pdf_le(const LightModel& m, const SceneSphere& sphere, vec3 d, float& pdf_p
                           [&](const SpotLight& l) {
                               pdf_pos = 1.f;
                               pdf_dir = square_to_uniform_cone_pdf(l.to_local(d), std::cos(radians(l.cutoff_angle)));
+                          },
+                          [&](const ProjectorLight& l) {
+                              pdf_pos = 1.f;
+                              pdf_dir = 0.f;
+                              const vec3 local = l.to_local(d);
+                              vec2 uv;
+                              if (!l.density || !l.uv_of(local, uv)) return;
+                              const float z = local.z / glm::length(local);
+                              pdf_dir = l.density->pdf(uv) / (l.image_area() * z * z * z);
                           },
                           [&](const DirectionalLight&) {
                               pdf_pos = disk;

@@ -1,6 +1,6 @@
 #pragma once
-// The emitters that are not attached to a shape: Mitsuba 3.9's `point`, `spot`, `directional` and
-// `constant` and `envmap` (src/emitters/*.cpp), a closed set dispatched through std::variant. Area emitters live
+// The emitters that are not attached to a shape: Mitsuba 3.9's `point`, `spot`, `projector`,
+// `directional`, `constant` and `envmap` (src/emitters/*.cpp), a closed set dispatched through std::variant. Area emitters live
 // with their shapes in LightSet (light/area.h), which samples every light of the scene.
 //
 // Conventions (world space throughout, directions unit length):
@@ -8,13 +8,13 @@
 //   w (eval)  direction from the scene out to an infinite light (= the escaping ray's direction)
 //   Li        what sample_li returns as LightSample::Le:
 //               area, constant, envmap: radiance arriving along -wi (W m^-2 sr^-1)
-//               point, spot:    intensity / dist^2 (the delta position is folded in)
+//               point, spot, projector: intensity / dist^2 (the delta position is folded in)
 //               directional:    irradiance at a surface facing it
 //             so that the direct-light estimate is always f(wo, wi) |cos| Le / pdf.
 //   pdf       area, constant, envmap: solid angle at the reference point; delta lights: 1 (a discrete
 //             choice). LightSet multiplies in the pmf of choosing the light.
 //   sample_le a ray leaving the light (for light tracing, BDPT, MLT) with Le the radiance it
-//             carries (point, spot: intensity; directional: irradiance), pdf_pos (area measure on
+//             carries (point, spot, projector: intensity; directional: irradiance), pdf_pos (area measure on
 //             the light, or on the disk of the scene's bounding sphere for directional and
 //             infinite lights, 1 for a delta position) and pdf_dir (solid angle, 1 for a delta
 //             direction), as pbrt-v4's Light::SampleLe; the estimate of a light path's start is
@@ -26,6 +26,7 @@
 #include "core/frame.h"
 #include "core/ray.h"
 #include "light/envmap.h"
+#include "sampling/distribution.h"
 #include "texture/texture.h"
 
 namespace candela {
@@ -88,6 +89,34 @@ struct SpotLight {
     vec3 to_local(vec3 w) const { return glm::normalize(glm::inverse(glm::mat3(to_world)) * w); }
 };
 
+// Mitsuba's `projector`: a pinhole at the origin of to_world (a rotation and a translation) looking
+// along its +z, which projects `irradiance` onto its image plane at z = 1 as the perspective camera
+// maps its film: uv = (1/2 - x / (2 z tan_x), 1/2 - y / (2 z tan_y)) for a local direction (x, y, z),
+// tan_x from the fov (along fov_axis, for the texture's aspect ratio) and tan_y = tan_x / aspect.
+// The irradiance on that plane is pi * scale * irradiance(uv), so the intensity along a local unit
+// direction d inside the frustum is pi * scale * irradiance(uv) / d.z^3 (and 0 outside), as
+// Mitsuba's sample_direction gives it. Emission sampling picks uv from `density` (the texture's
+// values plus a uniform part, so that every uv where bilinear filtering can give light is
+// reachable) and maps it to a direction: pdf_dir = pdf_uv / (image area * d.z^3).
+struct ProjectorLight {
+    mat4 to_world{1.f};
+    std::shared_ptr<const Texture> irradiance;
+    vec3 scale{1.f};  // Mitsuba's float scale, per channel so that the viewer edits it as a strength
+    float tan_x = 1.f, tan_y = 1.f;
+    std::shared_ptr<const Distribution2D> density;  // over uv; see build_density()
+
+    vec3 position() const { return vec3(to_world[3]); }
+    vec3 to_local(vec3 w) const { return glm::transpose(glm::mat3(to_world)) * w; }  // rigid
+    vec3 to_world_dir(vec3 d) const { return glm::mat3(to_world) * d; }
+    // The image-plane coordinates of local direction d (any length); false outside the frustum.
+    bool uv_of(vec3 d, vec2& uv) const;
+    // The local unit direction through uv, and its z (the cosine to the axis).
+    vec3 direction_of(vec2 uv) const;
+    float image_area() const { return 4.f * tan_x * tan_y; }
+    // Builds `density` from the texture (call after setting irradiance).
+    void build_density();
+};
+
 // Mitsuba's `directional`: irradiance E (W/m^2) arriving along `direction` (the way the light
 // travels, unit; Mitsuba's to_world +z).
 struct DirectionalLight {
@@ -118,7 +147,7 @@ struct EnvmapLight {
     vec3 from_local(vec3 d) const { return glm::normalize(frame * d); }
 };
 
-using LightModel = std::variant<PointLight, SpotLight, DirectionalLight, ConstantLight, EnvmapLight>;
+using LightModel = std::variant<PointLight, SpotLight, ProjectorLight, DirectionalLight, ConstantLight, EnvmapLight>;
 
 struct Light {
     std::string name;  // the XML id, or "<type> k"
@@ -127,14 +156,14 @@ struct Light {
 
 uint32_t light_flags(const LightModel& m);
 const char* light_type_name(const LightModel& m);  // Mitsuba's plugin name
-// The parameter the viewer edits: intensity, irradiance, radiance or (envmap) scale.
+// The parameter the viewer edits: intensity, irradiance, radiance or (envmap, projector) scale.
 vec3& light_strength(LightModel& m);
 vec3 light_strength(const LightModel& m);
 const char* light_strength_name(const LightModel& m);
 bool same_light(const Light& a, const Light& b);
 
 // Next-event sampling of one light from ref_p (pdf without the light's pmf). False when it cannot
-// light ref_p (outside a spot's cone, zero strength).
+// light ref_p (outside a spot's cone or a projector's frustum, zero strength).
 bool sample_li(const LightModel& m, const SceneSphere& sphere, vec3 ref_p, vec2 u, LightSample& out);
 // Solid-angle density of sample_li choosing w (0 for delta lights).
 float pdf_li(const LightModel& m, vec3 w);

@@ -11,6 +11,8 @@ float finite_float(const ParamSet& p, const std::string& name, float def) {
     return v;
 }
 
+}  // namespace
+
 // The field of view of the perspective and thin lens cameras: `fov` along `fov_axis`, or a
 // 35 mm-equivalent `focal_length` (a string "<x>mm" or "<x>", default "50mm") on the diagonal.
 void read_fov(const ParamSet& p, Camera& cam) {
@@ -44,6 +46,8 @@ void read_fov(const ParamSet& p, Camera& cam) {
     // Mitsuba reads fov_axis only with fov: without one it is not an error, and does nothing.
     if (p.has("fov_axis")) p.get_string("fov_axis", "");
 }
+
+namespace {
 
 // What every projective camera reads (Mitsuba's Sensor and ProjectiveCamera constructors).
 void read_projective(const ParamSet& p, Camera& cam, bool rigid) {

@@ -15,6 +15,11 @@ bool is_supported_sensor(const std::string& type);
 // "perspective, thinlens, orthographic" for messages.
 const char* supported_sensors();
 
+// The field of view Mitsuba's parse_fov reads: `fov` (degrees, in (0, 180)) along `fov_axis`, or a
+// 35 mm-equivalent `focal_length` ("<x>mm", default "50mm") on the diagonal; into cam.fov_deg and
+// cam.fov_axis. Also read by the projector emitter, which takes a camera's parameters.
+void read_fov(const ParamSet& p, Camera& cam);
+
 // A camera of sensor type `type` (is_supported_sensor) from its parameters. The film geometry
 // (film_size, crop) is left for apply_film.
 Camera make_sensor(const std::string& type, const ParamSet& p);

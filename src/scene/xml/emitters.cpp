@@ -1,7 +1,8 @@
 // The emitter family of the XML reader, one table for every emitter plugin: `area` (nested in a
-// shape, or referenced by one) and the top-level `point`, `spot`, `directional`, `constant` and
-// `envmap` (light/emitter.h). As Mitsuba's Scene, a scene takes at most one environment emitter
+// shape, or referenced by one) and the top-level `point`, `spot`, `projector`, `directional`,
+// `constant` and `envmap` (light/emitter.h). As Mitsuba's Scene, a scene takes at most one environment emitter
 // (an infinite light that is not a delta: constant or envmap).
+#include "scene/sensors.h"
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -9,16 +10,22 @@ namespace xml {
 
 namespace {
 
-// A value, or a nested texture that is a constant (srgb, d65, uniform, rawconstant): folded into the
-// value, since these emitters take no spatially varying strength.
+// The value of a nested constant texture (srgb, d65, uniform, rawconstant) given for `name`: not
+// also given as a value, finite and not negative. Null when the texture varies.
+const vec3* constant_strength(XmlLoader& L, Object& e, const char* name, const Texture& t) {
+    if (e.params.has(name)) throw e.params.error(name, std::string("'") + name + "' is given both as a value and as a texture");
+    const ConstantTexture* c = std::get_if<ConstantTexture>(&t.v);
+    if (c && (!all_finite(c->value) || !(min_component(c->value) >= 0.f)))
+        throw L.error(e.node, std::string(name) + " must be finite and not negative");
+    return c ? &c->value : nullptr;
+}
+
+// A value, or a nested texture that is a constant: folded into the value, since these emitters take
+// no spatially varying strength.
 vec3 strength(XmlLoader& L, Object& e, const char* name) {
     if (std::shared_ptr<const Texture> t = nested_texture(L, e, name)) {
-        if (e.params.has(name)) throw e.params.error(name, std::string("'") + name + "' is given both as a value and as a texture");
-        const ConstantTexture* c = std::get_if<ConstantTexture>(&t->v);
-        if (!c) throw L.error(e.node, std::string("a varying texture for '") + name + "' is not supported by " + e.what());
-        if (!all_finite(c->value) || !(min_component(c->value) >= 0.f))
-            throw L.error(e.node, std::string(name) + " must be finite and not negative");
-        return c->value;
+        if (const vec3* c = constant_strength(L, e, name, *t)) return *c;
+        throw L.error(e.node, std::string("a varying texture for '") + name + "' is not supported by " + e.what());
     }
     vec3 v = e.params.get_rgb(name, vec3(1.f));
     if (!all_finite(v) || !(min_component(v) >= 0.f))
@@ -38,13 +45,7 @@ EmitterModel make_area(XmlLoader& L, Object& e) {
     // A textured radiance (bitmap, checkerboard): evaluated at the uv of each emitting point.
     std::shared_ptr<const Texture> t = nested_texture(L, e, "radiance");
     if (!t) return AreaEmitter{strength(L, e, "radiance"), nullptr};
-    if (const ConstantTexture* c = std::get_if<ConstantTexture>(&t->v)) {  // d65, srgb...: a plain value
-        if (e.params.has("radiance")) throw e.params.error("radiance", "'radiance' is given both as a value and as a texture");
-        if (!all_finite(c->value) || !(min_component(c->value) >= 0.f))
-            throw L.error(e.node, "radiance must be finite and not negative");
-        return AreaEmitter{c->value, nullptr};
-    }
-    if (e.params.has("radiance")) throw e.params.error("radiance", "'radiance' is given both as a value and as a texture");
+    if (const vec3* c = constant_strength(L, e, "radiance", *t)) return AreaEmitter{*c, nullptr};  // d65, srgb...
     if (t->uses_vertex_colors())
         throw L.error(e.node, "a radiance texture that reads vertex colours (mesh_attribute) is not supported");
     return AreaEmitter{vec3(0.f), t};
@@ -76,6 +77,50 @@ EmitterModel make_spot(XmlLoader& L, Object& e) {
     l.texture = nested_texture(L, e, "texture");
     if (l.texture && l.texture->is_constant())
         throw L.error(e.node, "spot: 'texture' must vary over the cone (e.g. a bitmap), as in Mitsuba");
+    return l;
+}
+
+EmitterModel make_projector(XmlLoader& L, Object& e) {
+    ProjectorLight l;
+    if (std::shared_ptr<const Texture> t = nested_texture(L, e, "irradiance")) {
+        if (const vec3* c = constant_strength(L, e, "irradiance", *t)) {
+            l.irradiance = std::make_shared<const Texture>(constant_texture(*c));
+        } else {
+            if (t->uses_vertex_colors())
+                throw L.error(e.node, "projector: an irradiance texture that reads vertex colours (mesh_attribute) is not supported");
+            l.irradiance = t;
+        }
+    } else if (e.params.has("irradiance")) {
+        l.irradiance = std::make_shared<const Texture>(constant_texture(strength(L, e, "irradiance")));
+    } else {
+        throw L.error(e.node, "projector needs an 'irradiance' (a texture or a value), as in Mitsuba");
+    }
+    const float scale = e.params.get_float("scale", 1.f);
+    if (!std::isfinite(scale) || !(scale >= 0.f)) throw e.params.error("scale", "scale must be finite and not negative");
+    l.scale = vec3(scale);
+    l.to_world = e.params.get_transform("to_world", mat4(1.f));
+    // A rotation and a translation: a scale would change the projected irradiance in a way Mitsuba's
+    // own emission sampling does not follow (its sample_direction and sample_ray disagree then).
+    const glm::mat3 r(l.to_world);
+    const glm::mat3 rtr = glm::transpose(r) * r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            if (!(std::abs(rtr[i][j] - (i == j ? 1.f : 0.f)) < 1e-4f))
+                throw e.params.error("to_world", "projector: to_world must be a rotation and a translation (no scale or shear)");
+    if (!all_finite(l.position())) throw e.params.error("to_world", "projector: the position is not finite");
+    // The image's aspect ratio is the texture's (a bitmap's resolution; 1 for anything else, as
+    // Mitsuba's Texture::resolution), and the fov is read as a perspective camera's.
+    float aspect = 1.f;
+    if (const BitmapTexture* b = std::get_if<BitmapTexture>(&l.irradiance->v))
+        aspect = float(b->texels->width) / float(b->texels->height);
+    Camera cam;
+    read_fov(e.params, cam);
+    const double x_fov = horizontal_fov(cam.fov_deg, cam.fov_axis, aspect);
+    l.tan_x = float(std::tan(0.5 * x_fov * M_PI / 180.0));
+    l.tan_y = l.tan_x / aspect;
+    if (!(l.tan_x > 0.f) || !std::isfinite(l.tan_x) || !(l.tan_y > 0.f) || !std::isfinite(l.tan_y))
+        throw L.error(e.node, "projector: the field of view gives no image (fov too close to 0 or 180 degrees)");
+    l.build_density();
     return l;
 }
 
@@ -129,7 +174,8 @@ EmitterModel make_envmap(XmlLoader& L, Object& e) {
 const PluginTable<EmitterFactory>& emitter_plugins() {
     static const PluginTable<EmitterFactory> table = {
         {"area", make_area},           {"point", make_point},       {"spot", make_spot},
-        {"directional", make_directional}, {"constant", make_constant}, {"envmap", make_envmap},
+        {"projector", make_projector}, {"directional", make_directional}, {"constant", make_constant},
+        {"envmap", make_envmap},
     };
     return table;
 }

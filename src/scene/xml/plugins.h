@@ -37,7 +37,7 @@ void load_shapegroup(XmlLoader& L, Object& o);
 void load_instance(XmlLoader& L, Object& o);
 
 // ---- emitters.cpp: <emitter> nested in a shape (area), and top-level emitters ----
-using EmitterModel = std::variant<AreaEmitter, PointLight, SpotLight, DirectionalLight, ConstantLight, EnvmapLight>;
+using EmitterModel = std::variant<AreaEmitter, PointLight, SpotLight, ProjectorLight, DirectionalLight, ConstantLight, EnvmapLight>;
 using EmitterFactory = EmitterModel (*)(XmlLoader&, Object&);
 const PluginTable<EmitterFactory>& emitter_plugins();
 // The emitter nested in a shape: its index in scene().emitters.
