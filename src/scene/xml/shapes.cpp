@@ -14,6 +14,12 @@ namespace xml {
 
 namespace {
 
+// A shape's nested <emitter>, or a <ref> to one.
+bool is_emitter_child(XmlLoader& L, const Nested& c) {
+    if (c.tag == "emitter") return true;
+    return c.tag == "ref" && L.object_by_id(c.node, L.required_attr(c.node, "id"), "").tag == "emitter";
+}
+
 ShapeGeometry make_obj(XmlLoader& L, Object& o) {
     if (!o.params.has("filename")) throw L.error(o.node, "shape 'obj' needs a 'filename' string");
     std::string file = o.params.get_string("filename", "");
@@ -156,11 +162,9 @@ void load_linearcurve(XmlLoader& L, pugi::xml_node n, Object& o) {
         throw Error(std::string(e.what()) + " (shape at " + L.path() + ":" + std::to_string(o.line) + ")");
     }
     const uint32_t material = L.material_for(o);
-    for (Nested& c : o.nested) {
-        const bool ref = c.tag == "ref" && L.object_by_id(c.node, L.required_attr(c.node, "id"), "").tag == "emitter";
-        if (c.tag == "emitter" || ref)
+    for (Nested& c : o.nested)
+        if (is_emitter_child(L, c))
             throw L.error(c.node, "a linearcurve cannot be an area emitter (Mitsuba cannot sample points on curves either)");
-    }
     L.finish(o);
     std::vector<vec3> world(f.points.size());
     for (size_t i = 0; i < f.points.size(); ++i) world[i] = vec3(m * glm::vec4(f.points[i], 1.f));
@@ -197,10 +201,9 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
 
     int32_t emitter = -1;
     for (Nested& c : o.nested) {
-        const bool ref = c.tag == "ref" && L.object_by_id(c.node, L.required_attr(c.node, "id"), "").tag == "emitter";
-        if (c.tag != "emitter" && !ref) continue;
+        if (!is_emitter_child(L, c)) continue;
         if (emitter >= 0) throw L.error(c.node, "a shape takes one emitter");
-        emitter = load_shape_emitter(L, ref ? L.definition(c, "emitter") : c.node);
+        emitter = load_shape_emitter(L, c.tag == "ref" ? L.definition(c, "emitter") : c.node);
         if (analytic && L.scene().emitters[size_t(emitter)].texture)
             throw L.error(c.node, "a textured radiance is supported on meshes only, not on a " + o.type);
         c.used = true;
