@@ -24,6 +24,7 @@
 #include "scene/camera.h"
 #include "sampling/warp.h"
 #include "scene/scene.h"
+#include "support/load_error.h"
 #include "support/render.h"
 #include "support/run.h"
 #include "support/stats.h"
@@ -491,29 +492,11 @@ TEST(Emitters, ProjectorMatchesMitsuba) {
     }
 }
 
-namespace {
-
-// Loading a scene of `body` fails with one line that contains `needle` and names the file.
-void expect_scene_error(const std::string& dir, const std::string& body, const std::string& needle) {
-    const std::string path = dir + "/scene.xml";
-    test::write_text(path, "<scene version=\"3.0.0\">\n" + body + "\n</scene>\n");
-    try {
-        load_scene(path);
-        ADD_FAILURE() << "no error for " << body;
-    } catch (const Error& e) {
-        const std::string what = e.what();
-        EXPECT_NE(what.find(needle), std::string::npos) << what;
-        EXPECT_NE(what.find("scene.xml:"), std::string::npos) << what;
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    }
-}
-
-}  // namespace
 
 TEST(Emitters, ProjectorErrors) {
     const std::string dir = test::temp_dir("emitters-projector-bad");
     auto expect_error = [&](const std::string& body, const std::string& needle) {
-        expect_scene_error(dir, "<emitter type=\"projector\">\n" + body + "\n</emitter>", needle);
+        test::expect_load_error(dir, "<emitter type=\"projector\">\n" + body + "\n</emitter>", needle);
     };
     expect_error("<float name=\"fov\" value=\"40\"/>", "needs an 'irradiance'");
     expect_error("<rgb name=\"irradiance\" value=\"1\"/><float name=\"fov\" value=\"180\"/>", "fov must be in (0, 180)");
@@ -559,7 +542,7 @@ TEST(Emitters, TexturedAreaRadianceMatchesMitsuba) {
 
 TEST(Emitters, TexturedRadianceErrors) {
     const std::string dir = test::temp_dir("emitters-textured-bad");
-    auto expect_error = [&](const std::string& shape, const std::string& needle) { expect_scene_error(dir, shape, needle); };
+    auto expect_error = [&](const std::string& shape, const std::string& needle) { test::expect_load_error(dir, shape, needle); };
     const std::string checker = "<texture type=\"checkerboard\" name=\"radiance\"/>";
     expect_error("<shape type=\"sphere\"><emitter type=\"area\">" + checker + "</emitter></shape>",
                  "supported on meshes only");
@@ -575,7 +558,7 @@ TEST(Emitters, TexturedRadianceErrors) {
 
 TEST(Emitters, BadInputIsOneLineWithFileAndLine) {
     const std::string dir = test::temp_dir("emitters-bad");
-    auto expect_error = [&](const std::string& emitter, const std::string& needle) { expect_scene_error(dir, emitter, needle); };
+    auto expect_error = [&](const std::string& emitter, const std::string& needle) { test::expect_load_error(dir, emitter, needle); };
     expect_error("<emitter type=\"point\"><rgb name=\"intensity\" value=\"-1\"/></emitter>", "must be finite and not negative");
     expect_error("<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"95\"/></emitter>", "cutoff_angle must be in (0, 90]");
     expect_error("<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"0\"/></emitter>", "cutoff_angle must be in (0, 90]");

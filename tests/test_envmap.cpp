@@ -30,6 +30,7 @@
 #include "sampling/warp.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
+#include "support/load_error.h"
 #include "support/render.h"
 #include "support/run.h"
 #include "support/stats.h"
@@ -421,17 +422,7 @@ TEST(Envmap, BadInputIsOneLineWithFileAndLine) {
         return "<emitter type=\"envmap\"><string name=\"filename\" value=\"" + file + "\"/>" + extra + "</emitter>";
     };
     auto expect_error = [&](const std::string& body, const std::string& needle) {
-        const std::string path = dir + "/scene.xml";
-        test::write_text(path, "<scene version=\"3.0.0\">\n" + body + "\n</scene>\n");
-        try {
-            load_scene(path);
-            ADD_FAILURE() << "no error for " << body;
-        } catch (const Error& err) {
-            const std::string what = err.what();
-            EXPECT_NE(what.find(needle), std::string::npos) << what;
-            EXPECT_NE(what.find("scene.xml:2:"), std::string::npos) << what;
-            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-        }
+        test::expect_load_error(dir, body, needle, "scene.xml:2:");
     };
     expect_error(envmap("missing_sky.exr"), "not found");
     expect_error(envmap(dir + "/not_an_image.exr"), "envmap");

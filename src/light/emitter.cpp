@@ -220,9 +220,8 @@ bool sample_li(const LightModel& m, const SceneSphere& sphere, vec3 ref_p, vec2 
                 vec2 uv;
                 if (!l.uv_of(local, uv)) return false;
                 // Mitsuba's sample_direction: pi scale E(uv) / (z^2 cos), z the reference point's depth
-                // along the axis and cos the angle to it (= pi scale E / cos^3 / dist^2).
-                const float cos_axis = -glm::dot(l.to_world_dir(vec3(0.f, 0.f, 1.f)), out.wi);
-                if (!(cos_axis > 0.f)) return false;
+                // along the axis and cos = z / dist the angle to it (= pi scale E / cos^3 / dist^2).
+                const float cos_axis = local.z / out.dist;
                 TextureQuery q;
                 q.uv = uv;
                 out.Le = kPi * l.scale * l.irradiance->eval(q) / (local.z * local.z * cos_axis);

@@ -83,13 +83,9 @@ EmitterModel make_spot(XmlLoader& L, Object& e) {
 EmitterModel make_projector(XmlLoader& L, Object& e) {
     ProjectorLight l;
     if (std::shared_ptr<const Texture> t = nested_texture(L, e, "irradiance")) {
-        if (const vec3* c = constant_strength(L, e, "irradiance", *t)) {
-            l.irradiance = std::make_shared<const Texture>(constant_texture(*c));
-        } else {
-            if (t->uses_vertex_colors())
-                throw L.error(e.node, "projector: an irradiance texture that reads vertex colours (mesh_attribute) is not supported");
-            l.irradiance = t;
-        }
+        if (!constant_strength(L, e, "irradiance", *t) && t->uses_vertex_colors())  // a constant is checked there
+            throw L.error(e.node, "projector: an irradiance texture that reads vertex colours (mesh_attribute) is not supported");
+        l.irradiance = t;
     } else if (e.params.has("irradiance")) {
         l.irradiance = std::make_shared<const Texture>(constant_texture(strength(L, e, "irradiance")));
     } else {
