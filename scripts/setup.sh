@@ -9,7 +9,7 @@ pkgs=(
   cmake ninja-build g++ pkg-config
   libglfw3-dev libglm-dev libimgui-dev libtinyobjloader-dev libstb-dev
   libosmesa6-dev libgl-dev libpugixml-dev libcli11-dev libtinyexr-dev
-  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev libhwy-dev
+  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev libjpeg62-turbo-dev libhwy-dev
   xvfb xauth
 )
 for a in "$@"; do

@@ -5,6 +5,11 @@
 #include <gtest/gtest.h>
 #include <cstring>
 #include <fstream>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <jpeglib.h>  // after <cstdio>: it uses FILE
 #include <glm/gtc/matrix_transform.hpp>
 #include "core/error.h"
 #include "support/bsdf_xml.h"
@@ -323,10 +328,30 @@ TEST(Texture, BadImageFilesAreCleanErrors) {
     std::string good = candela::test::read_bytes(data_file("rgb3x2.png"));
     candela::test::write_text(dir + "/truncated.png", good.substr(0, good.size() / 2));
     expect_error(dir + "/truncated.png", "truncated.png");
-    // A JPEG whose Huffman code counts sum to more than 256 (found by tests/fuzz/fuzz_image.cpp: Debian
-    // 12's stb_image writes past its table there) is refused before stb_image sees it; a good JPEG
-    // still decodes.
-    expect_error(data_file("bad_huffman.jpg"), "corrupt JPEG Huffman table");
+    // Fuzzer findings against Debian 12's stb_image JPEG decoder, now refused by libjpeg-turbo or
+    // before decoding: Huffman code counts summing to more than 256 (stb wrote past its table), a
+    // scan using an undefined table (an undefined shift in stb), and 836 bytes claiming 16386 x
+    // 6400 texels (stb decoded 105 megatexels of zeros: 45 s and 1.9 GB under ASan).
+    expect_error(data_file("bad_huffman.jpg"), "Bogus Huffman table");
+    expect_error(data_file("undefined_huffman.jpg"), "Huffman table 0x02 was not defined");
+    expect_error(data_file("claims_16386x6400.jpg"), "JPEG claims 16386x6400 texels, more than its 836 bytes");
+    // The same for the formats stb_image still reads: a BMP header claiming 10000 x 10000 texels.
+    std::string bmp = "BM" + std::string(52, '\0');
+    auto put32 = [&](size_t at, uint32_t v) { for (int k = 0; k < 4; ++k) bmp[at + size_t(k)] = char(v >> (8 * k)); };
+    put32(10, 54), put32(14, 40), put32(18, 10000), put32(22, 10000);
+    bmp[26] = 1, bmp[28] = 24;
+    candela::test::write_text(dir + "/huge.bmp", bmp);
+    expect_error(dir + "/huge.bmp", "image claims 10000x10000 texels, more than its 54 bytes");
+    // PGM/PPM headers (found by fuzz_image: stb_image's parser overflowed a signed int on a long
+    // number); binary PNM is read by decode_pnm now.
+    candela::test::write_text(dir + "/long.pgm", "P5 54 6227103515 4  \xcc");
+    expect_error(dir + "/long.pgm", "bad PNM header: height above 1048576");
+    candela::test::write_text(dir + "/short.ppm", "P6 4 4 255\n" + std::string(47, 'x'));
+    expect_error(dir + "/short.ppm", "truncated PNM: 47 bytes of raster, expected 48");
+    candela::test::write_text(dir + "/nomax.ppm", "P6 4 4 # no maxval\n");
+    expect_error(dir + "/nomax.ppm", "bad PNM header: no maxval");
+    candela::test::write_text(dir + "/anim.gif", std::string("GIF89a") + std::string(40, '\0'));
+    expect_error(dir + "/anim.gif", "unsupported image format");
     auto jpg = load_texels(data_file("rgb2x2.jpg"), false);
     EXPECT_EQ(jpg->width, 2);
     EXPECT_EQ(jpg->height, 2);
@@ -334,6 +359,90 @@ TEST(Texture, BadImageFilesAreCleanErrors) {
     // A 2 x 2 PIZ-compressed EXR whose chunk is whole but does not decode (found by fuzz_image:
     // tinyexr 1.0.1 leaked its channel buffers there; the sanitizer build's leak checker sees it).
     expect_error(data_file("bad_piz.exr"), "cannot decode EXR pixels");
+}
+
+// A JPEG written by libjpeg here (64 x 48, colour gradients, quality 100, no chroma subsampling),
+// baseline and progressive, decodes to its source texels within the codec's error, the right way
+// up and in RGB order; cut short, it is a one-line error rather than a grey-filled image.
+TEST(Texture, JpegDecodesAndTruncatedJpegIsAnError) {
+    const std::string dir = candela::test::temp_dir("texture_jpeg");
+    const int w = 64, h = 48;
+    std::vector<uint8_t> src(size_t(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            uint8_t* p = &src[3 * (size_t(y) * w + x)];
+            p[0] = uint8_t(4 * x), p[1] = uint8_t(5 * y), p[2] = uint8_t(200 - 2 * x);
+        }
+    for (bool progressive : {false, true}) {
+        jpeg_compress_struct c;
+        jpeg_error_mgr err;
+        c.err = jpeg_std_error(&err);
+        jpeg_create_compress(&c);
+        unsigned char* out = nullptr;
+        unsigned long size = 0;
+        jpeg_mem_dest(&c, &out, &size);
+        c.image_width = w, c.image_height = h, c.input_components = 3, c.in_color_space = JCS_RGB;
+        jpeg_set_defaults(&c);
+        jpeg_set_quality(&c, 100, TRUE);
+        for (int k = 0; k < 3; ++k) c.comp_info[k].h_samp_factor = c.comp_info[k].v_samp_factor = 1;
+        if (progressive) jpeg_simple_progression(&c);
+        jpeg_start_compress(&c, TRUE);
+        while (c.next_scanline < c.image_height) {
+            JSAMPROW row = &src[size_t(c.next_scanline) * w * 3];
+            jpeg_write_scanlines(&c, &row, 1);
+        }
+        jpeg_finish_compress(&c);
+        const std::string bytes(reinterpret_cast<const char*>(out), size);
+        jpeg_destroy_compress(&c);
+        std::free(out);
+
+        const std::string path = dir + (progressive ? "/progressive.jpg" : "/baseline.jpg");
+        candela::test::write_text(path, bytes);
+        auto g = load_texels(path, true);
+        ASSERT_EQ(g->width, w);
+        ASSERT_EQ(g->height, h);
+        ASSERT_EQ(g->channels, 3);
+        float worst = 0.f;
+        for (size_t i = 0; i < src.size(); ++i) worst = std::max(worst, std::abs(g->data[i] * 255.f - float(src[i])));
+        EXPECT_LE(worst, 3.f) << path;  // quality 100: a few levels at most
+        auto lin = load_texels(path, false);  // sRGB-decoded unless raw
+        EXPECT_NEAR(lin->data[3 * 10 + 1], srgb_to_linear(g->data[3 * 10 + 1]), 1e-6f);
+
+        const std::string cut = dir + (progressive ? "/progressive_cut.jpg" : "/baseline_cut.jpg");
+        candela::test::write_text(cut, bytes.substr(0, bytes.size() * 2 / 3));
+        try {
+            load_texels(cut, false);
+            ADD_FAILURE() << cut << " was accepted";
+        } catch (const Error& e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find(cut), std::string::npos) << msg;
+            EXPECT_NE(msg.find("Premature end of JPEG file"), std::string::npos) << msg;
+        }
+    }
+}
+
+// Binary PGM and PPM: comments in the header, 8 and 16 bits (big-endian), values over maxval,
+// rows from the top; decoded from sRGB unless raw, like the other 8/16-bit formats.
+TEST(Texture, PnmDecodes) {
+    const std::string dir = candela::test::temp_dir("texture_pnm");
+    // 2 x 1 colour, maxval 255: (255, 0, 51) and (0, 102, 255).
+    candela::test::write_text(dir + "/a.ppm", std::string("P6\n# made by hand\n2 1\n255\n") + std::string("\xff\x00\x33\x00\x66\xff", 6));
+    auto c = load_texels(dir + "/a.ppm", true);
+    ASSERT_EQ(c->width, 2);
+    ASSERT_EQ(c->height, 1);
+    ASSERT_EQ(c->channels, 3);
+    const float want[6] = {1.f, 0.f, 0.2f, 0.f, 0.4f, 1.f};
+    for (int i = 0; i < 6; ++i) EXPECT_NEAR(c->data[size_t(i)], want[i], 1e-6f) << i;
+    auto lin = load_texels(dir + "/a.ppm", false);
+    EXPECT_NEAR(lin->data[2], srgb_to_linear(0.2f), 1e-6f);
+    // 1 x 2 grey, maxval 1000 (two bytes a sample): 500 on top, 1000 below.
+    candela::test::write_text(dir + "/b.pgm", std::string("P5 1 2 1000\n") + std::string("\x01\xf4\x03\xe8", 4));
+    auto g = load_texels(dir + "/b.pgm", true);
+    ASSERT_EQ(g->width, 1);
+    ASSERT_EQ(g->height, 2);
+    ASSERT_EQ(g->channels, 1);
+    EXPECT_NEAR(g->data[0], 0.5f, 1e-6f);
+    EXPECT_NEAR(g->data[1], 1.f, 1e-6f);
 }
 
 // ---- textured materials in a render, against Mitsuba -------------------------------------------

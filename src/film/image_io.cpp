@@ -38,14 +38,6 @@ void check_image(const std::string& path, const Image& img) {
                                  std::to_string(size_t(img.width) * size_t(img.height)));
 }
 
-std::vector<unsigned char> read_whole_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path, 0, "cannot open: " + errno_text(errno));
-    std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw Error(path, 0, "read error");
-    return data;
-}
-
 // ---- EXR -----------------------------------------------------------------------------------------
 
 // tinyexr hands out C allocations and error strings; these guards free them on every path.
@@ -362,6 +354,14 @@ void write_linear_image(const std::string& path, const Image& img) {
     check_image(path, img);
     if (ext == ".exr") write_exr(path, img);
     else write_pfm(path, img);
+}
+
+std::vector<unsigned char> read_whole_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path, 0, "cannot open: " + errno_text(errno));
+    std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw Error(path, 0, "read error");
+    return data;
 }
 
 Image read_linear_image(const std::string& path) {

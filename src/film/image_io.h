@@ -19,6 +19,9 @@ void write_linear_image(const std::string& path, const Image& img);
 // Reads .exr or .pfm (any channel count; returned as RGB). Throws Error naming the file.
 Image read_linear_image(const std::string& path);
 
+// The whole file as bytes. Throws Error naming the file when it cannot be read.
+std::vector<unsigned char> read_whole_file(const std::string& path);
+
 // Lower-case extension including the dot (".png"), or "" when there is none.
 std::string file_extension(const std::string& path);
 

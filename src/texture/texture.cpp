@@ -3,14 +3,23 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <memory>
+#include <type_traits>
+#include <climits>
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
+// JPEG goes to libjpeg-turbo and PGM/PPM to decode_pnm (texture/decode.h); GIF, PSD and PIC are
+// refused before decoding.
+#define STBI_NO_JPEG
+#define STBI_NO_PNM
+#define STBI_NO_GIF
+#define STBI_NO_PSD
+#define STBI_NO_PIC
 #include <stb/stb_image.h>
 #include "core/error.h"
 #include "film/image_io.h"
+#include "texture/decode.h"
 
 namespace candela {
 
@@ -28,47 +37,6 @@ float srgb_to_linear(float v) {
 }
 
 namespace {
-
-// Debian 12's stb_image builds a JPEG Huffman table without checking that its code counts sum to at
-// most 256 (fixed upstream later), and writes past the table for a corrupt file (found by
-// tests/fuzz/fuzz_image.cpp). So every DHT segment is checked here first, walking the JPEG's
-// markers, including those between the scans of a progressive file.
-bool jpeg_huffman_tables_valid(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    std::string b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    auto at = [&](size_t i) { return i < b.size() ? uint8_t(b[i]) : uint8_t(0); };
-    // stb_image reads past the end of a file as zeros and skips fill bytes (0xFF) before a marker;
-    // so does this walk.
-    size_t i = 0;
-    while (at(i) == 0xFF && at(i + 1) == 0xFF) ++i;
-    if (at(i) != 0xFF || at(i + 1) != 0xD8) return true;  // not a JPEG
-    i += 2;
-    while (i + 4 <= b.size()) {
-        if (at(i) != 0xFF) {  // entropy-coded data: skip to the next marker that is not a stuffed 0 or RSTn
-            ++i;
-            continue;
-        }
-        const uint8_t m = at(i + 1);
-        if (m == 0x00 || m == 0xFF || (m >= 0xD0 && m <= 0xD7) || m == 0x01) {
-            i += m == 0xFF ? 1 : 2;
-            continue;
-        }
-        if (m == 0xD9) break;  // end of image
-        const size_t len = size_t(at(i + 2)) << 8 | at(i + 3);
-        if (len < 2) return false;
-        if (m == 0xC4) {
-            size_t k = i + 4, end = i + 2 + len;
-            while (k < end && k < b.size()) {
-                size_t n = 0;
-                for (int c = 0; c < 16; ++c) n += at(k + 1 + size_t(c));
-                if (n > 256) return false;
-                k += 17 + n;
-            }
-        }
-        i += 2 + len;
-    }
-    return true;
-}
 
 // Texel index `i` of a grid `n` texels wide, wrapped by the mode (Mitsuba's, for any integer).
 int wrap_index(int i, int n, TextureWrap mode) {
@@ -154,6 +122,31 @@ bool Texture::uses_vertex_colors() const {
     return false;
 }
 
+namespace {
+
+enum class ImageKind { Png, Jpeg, Pnm, Refused, Other };
+
+// By magic number, as stb_image and libjpeg recognise them; TGA has none and falls in Other.
+ImageKind image_kind(const std::vector<unsigned char>& b) {
+    auto starts = [&](const char* m, size_t n) { return b.size() >= n && std::equal(m, m + n, b.begin(), [](char c, unsigned char u) { return uint8_t(c) == u; }); };
+    if (starts("\x89PNG\r\n\x1a\n", 8)) return ImageKind::Png;
+    if (starts("\xFF\xD8\xFF", 3)) return ImageKind::Jpeg;
+    if (is_pnm(b)) return ImageKind::Pnm;
+    if (starts("GIF8", 4) || starts("8BPS", 4) || starts("\x53\x80\xF6\x34", 4)) return ImageKind::Refused;
+    return ImageKind::Other;
+}
+
+// The most texels a file of `bytes` bytes can hold, by format, so that a truncated file claiming a
+// large image is refused before it is decoded (stb_image reads missing bytes as zeros, and decoding
+// hundreds of megatexels from a few bytes takes seconds and gigabytes). PNG: deflate expands at
+// most 1032:1, times 8 one-bit texels a byte. The others stb_image reads (BMP, TGA, HDR)
+// expand at most 64:1 (a TGA run of 128 one-byte texels in 2 bytes; HDR runs give 16).
+double max_texels(ImageKind kind, size_t bytes) {
+    return (kind == ImageKind::Png ? 1032.0 * 8.0 : 64.0) * double(bytes);
+}
+
+}  // namespace
+
 std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw Error(path, 0, "texture file not found");
@@ -166,35 +159,53 @@ std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) 
         g->channels = 3;
         g->data = std::move(img.rgb);
     } else {
-        int w = 0, h = 0, n = 0;
-        if (!jpeg_huffman_tables_valid(path)) throw Error(path, 0, "cannot decode image: corrupt JPEG Huffman table");
-        if (!stbi_info(path.c_str(), &w, &h, &n))
-            throw Error(path, 0, std::string("cannot read image: ") + stbi_failure_reason());
-        // Images of more than 2^28 texels would need gigabytes as floats; refuse them before
-        // decoding (stb_image would try).
-        if (w <= 0 || h <= 0 || double(w) * double(h) > double(1 << 28))
-            throw Error(path, 0, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not supported");
-        const int want = (n == 1 || n == 2) ? 1 : 3;  // grey (+alpha) or colour (+alpha); alpha dropped
-        g->width = w;
-        g->height = h;
-        g->channels = want;
-        g->data.resize(size_t(w) * size_t(h) * size_t(want));
-        if (stbi_is_hdr(path.c_str())) {
-            float* px = stbi_loadf(path.c_str(), &w, &h, &n, want);
-            if (!px) throw Error(path, 0, std::string("cannot decode image: ") + stbi_failure_reason());
-            std::copy(px, px + g->data.size(), g->data.begin());
-            stbi_image_free(px);
-        } else {
-            const bool sixteen = stbi_is_16_bit(path.c_str());
-            const float scale = sixteen ? 1.f / 65535.f : 1.f / 255.f;
-            void* px = sixteen ? static_cast<void*>(stbi_load_16(path.c_str(), &w, &h, &n, want))
-                               : static_cast<void*>(stbi_load(path.c_str(), &w, &h, &n, want));
-            if (!px) throw Error(path, 0, std::string("cannot decode image: ") + stbi_failure_reason());
+        const std::vector<unsigned char> file = read_whole_file(path);
+        const ImageKind kind = image_kind(file);
+        if (kind == ImageKind::Refused)
+            throw Error(path, 0, "unsupported image format (GIF, PSD and PIC are not read; use PNG, JPEG or EXR)");
+        // A decoded 8- or 16-bit image, to floats: sRGB-decoded unless `raw`.
+        auto to_floats = [&](const auto* px, float scale) {
+            g->data.resize(size_t(g->width) * size_t(g->height) * size_t(g->channels));
             for (size_t i = 0; i < g->data.size(); ++i) {
-                float v = float(sixteen ? static_cast<const uint16_t*>(px)[i] : static_cast<const uint8_t*>(px)[i]) * scale;
+                const float v = float(px[i]) * scale;
                 g->data[i] = raw ? v : srgb_to_linear(v);
             }
-            stbi_image_free(px);
+        };
+        if (kind == ImageKind::Jpeg || kind == ImageKind::Pnm) {
+            const EncodedTexels t = kind == ImageKind::Jpeg ? decode_jpeg(path, file) : decode_pnm(path, file);
+            g->width = t.width;
+            g->height = t.height;
+            g->channels = t.channels;
+            to_floats(t.v.data(), 1.f);
+        } else {
+            const stbi_uc* bytes = file.data();
+            const int len = file.size() > size_t(INT32_MAX) ? INT32_MAX : int(file.size());
+            int w = 0, h = 0, n = 0;
+            if (!stbi_info_from_memory(bytes, len, &w, &h, &n))
+                throw Error(path, 0, std::string("cannot read image: ") + stbi_failure_reason());
+            const double texels = double(w) * double(h);
+            if (w <= 0 || h <= 0 || texels > double(kMaxTexels))
+                throw Error(path, 0, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not supported");
+            if (texels > max_texels(kind, file.size()))
+                throw Error(path, 0, "image claims " + std::to_string(w) + "x" + std::to_string(h) + " texels, more than its " +
+                                         std::to_string(file.size()) + " bytes can hold (truncated or corrupt)");
+            const int want = (n == 1 || n == 2) ? 1 : 3;  // grey (+alpha) or colour (+alpha); alpha dropped
+            g->width = w;
+            g->height = h;
+            g->channels = want;
+            auto fail = [&] { return Error(path, 0, std::string("cannot decode image: ") + stbi_failure_reason()); };
+            auto owned = [&](auto* px) {
+                if (!px) throw fail();
+                return std::unique_ptr<std::remove_pointer_t<decltype(px)>, void (*)(void*)>(px, stbi_image_free);
+            };
+            if (stbi_is_hdr_from_memory(bytes, len)) {
+                auto px = owned(stbi_loadf_from_memory(bytes, len, &w, &h, &n, want));
+                g->data.assign(px.get(), px.get() + size_t(g->width) * size_t(g->height) * size_t(want));
+            } else if (stbi_is_16_bit_from_memory(bytes, len)) {
+                to_floats(owned(stbi_load_16_from_memory(bytes, len, &w, &h, &n, want)).get(), 1.f / 65535.f);
+            } else {
+                to_floats(owned(stbi_load_from_memory(bytes, len, &w, &h, &n, want)).get(), 1.f / 255.f);
+            }
         }
     }
     for (float v : g->data)

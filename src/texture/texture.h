@@ -108,9 +108,14 @@ struct Texture {
 
 inline Texture constant_texture(vec3 c) { return Texture{ConstantTexture{c}}; }
 
-// Reads an image for a bitmap texture: PNG, JPEG, BMP, TGA (8 or 16 bit, decoded from sRGB unless
-// `raw`), HDR (RGBE) and EXR (linear float). Grey images keep one channel; alpha is dropped.
-// Throws Error naming the file for a missing, unreadable, corrupt or empty image.
+// Images of more than 2^28 texels would need gigabytes as floats: refused before decoding.
+constexpr long long kMaxTexels = 1LL << 28;
+
+// Reads an image for a bitmap texture, by its contents (not its extension), as Mitsuba 3 reads
+// them: PNG, JPEG, BMP, TGA, PPM/PGM (8 or 16 bit, decoded from sRGB unless `raw`), Radiance HDR,
+// and EXR or PFM (linear float). Grey images keep one channel; alpha is dropped. Throws Error
+// naming the file for a missing, unreadable, corrupt, truncated, empty or unsupported image (GIF,
+// PSD and PIC are refused: Mitsuba does not read them either).
 std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw);
 
 // The sRGB transfer function, decoded (IEC 61966-2-1, as Mitsuba's Bitmap conversion).

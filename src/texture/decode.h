@@ -1,0 +1,33 @@
+#pragma once
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace candela {
+
+// Texels as an 8- or 16-bit file stores them, scaled to [0, 1]: row-major from the top-left,
+// `channels` values per texel (1 for grey, 3 for colour), still in the file's encoding (sRGB
+// values, not yet linear).
+struct EncodedTexels {
+    int width = 0, height = 0, channels = 0;
+    std::vector<float> v;
+};
+
+// Decodes a JPEG held in memory with libjpeg-turbo (the decoder Mitsuba 3 uses too, so a JPEG
+// texture gives both renderers the same texels). Throws Error naming `path` on a corrupt, truncated
+// or CMYK file, and before decoding one whose header claims more texels than its bytes can hold.
+EncodedTexels decode_jpeg(const std::string& path, const std::vector<unsigned char>& file);
+
+// The most texels a JPEG of `bytes` bytes can code: each 8 x 8 block of the fullest component
+// costs at least one bit (its DC code, in a baseline or a progressive file), so 512 texels a byte.
+inline double jpeg_max_texels(size_t bytes) { return 512.0 * double(bytes); }
+
+// Decodes a binary PGM (P5) or PPM (P6) held in memory: 1 or 2 bytes a sample (big-endian) by
+// its maxval, values divided by maxval. Comments (#) are allowed in the header. Throws Error
+// naming `path` on a bad header or a short raster.
+EncodedTexels decode_pnm(const std::string& path, const std::vector<unsigned char>& file);
+
+// Whether the bytes start as a binary PGM or PPM does ("P5" or "P6" and whitespace).
+bool is_pnm(const std::vector<unsigned char>& file);
+
+}  // namespace candela
