@@ -445,6 +445,59 @@ TEST(Texture, PnmDecodes) {
     EXPECT_NEAR(g->data[1], 1.f, 1e-6f);
 }
 
+// Radiance RGBE, flat and run-length coded (8 x 2: runs and literals in each channel), to the same
+// linear texels, mantissa * 2^(e - 136) as Mitsuba converts; a run-length scanline cut short or a
+// zero-length run is an error (Debian 12's stb_image looped forever on the first).
+TEST(Texture, RgbeDecodesFlatAndRunLength) {
+    const std::string dir = candela::test::temp_dir("texture_rgbe");
+    const int w = 8, h = 2;
+    auto texel = [](int x, int y, int c) { return c == 3 ? uint8_t(128 + y) : uint8_t(c == 0 ? 200 : c == 1 ? 16 * x : 7); };
+    const std::string header = "#?RADIANCE\n# a comment\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1\n\n-Y 2 +X 8\n";
+    std::string flat = header, rle = header;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 4; ++c) flat += char(texel(x, y, c));
+        rle += std::string("\x02\x02\x00\x08", 4);
+        for (int c = 0; c < 4; ++c) {
+            if (c == 1) {  // a literal of all 8 values
+                rle += char(8);
+                for (int x = 0; x < w; ++x) rle += char(texel(x, y, c));
+            } else {  // a run of 5 and a run of 3
+                rle += char(128 + 5), rle += char(texel(0, y, c)), rle += char(128 + 3), rle += char(texel(0, y, c));
+            }
+        }
+    }
+    candela::test::write_text(dir + "/flat.hdr", flat);
+    candela::test::write_text(dir + "/rle.hdr", rle);
+    auto a = load_texels(dir + "/flat.hdr", false), b = load_texels(dir + "/rle.hdr", false);
+    ASSERT_EQ(a->width, w);
+    ASSERT_EQ(a->height, h);
+    ASSERT_EQ(b->width, w);
+    ASSERT_EQ(b->height, h);
+    EXPECT_EQ(a->data, b->data);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c)
+                EXPECT_EQ(a->data[3 * size_t(y * w + x) + size_t(c)], std::ldexp(float(texel(x, y, c)), 128 + y - 136));
+
+    auto expect_error = [](const std::string& path, const char* what) {
+        try {
+            load_texels(path, false);
+            ADD_FAILURE() << path << " was accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    candela::test::write_text(dir + "/cut.hdr", header + std::string("\x02\x02\x00\x08", 4));
+    expect_error(dir + "/cut.hdr", "truncated Radiance HDR pixel data");
+    candela::test::write_text(dir + "/zero_run.hdr", header + std::string("\x02\x02\x00\x08\x00\x00\x00\x00", 8));
+    expect_error(dir + "/zero_run.hdr", "bad run in scanline 0");
+    candela::test::write_text(dir + "/xyz.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 2 +X 8\n");
+    expect_error(dir + "/xyz.hdr", "unsupported Radiance HDR FORMAT=32-bit_rle_xyze");
+    candela::test::write_text(dir + "/flipped.hdr", "#?RADIANCE\n\n+Y 2 +X 8\n");
+    expect_error(dir + "/flipped.hdr", "resolution line");
+}
+
 // ---- textured materials in a render, against Mitsuba -------------------------------------------
 // tests/data/scenes/textured.xml (a checkerboard floor, a nearest-filtered bitmap wall, a smooth
 // plastic cube with a bilinear bitmap) against the mean of 16 Mitsuba 3.9.1 renders of 1024 spp

@@ -30,4 +30,12 @@ EncodedTexels decode_pnm(const std::string& path, const std::vector<unsigned cha
 // Whether the bytes start as a binary PGM or PPM does ("P5" or "P6" and whitespace).
 bool is_pnm(const std::vector<unsigned char>& file);
 
+// Decodes a Radiance RGBE file (.hdr) held in memory, flat or run-length coded, "-Y height +X
+// width" only, to linear RGB floats (3 a texel, from the top-left). Throws Error naming `path` on a
+// bad header, a corrupt run or a short file.
+std::vector<float> decode_rgbe(const std::string& path, const std::vector<unsigned char>& file, int& width, int& height);
+
+// Whether the bytes start as a Radiance file does ("#?" and a program name, e.g. "#?RADIANCE").
+bool is_rgbe(const std::vector<unsigned char>& file);
+
 }  // namespace candela

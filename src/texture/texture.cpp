@@ -9,10 +9,11 @@
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
-// JPEG goes to libjpeg-turbo and PGM/PPM to decode_pnm (texture/decode.h); GIF, PSD and PIC are
-// refused before decoding.
+// JPEG goes to libjpeg-turbo, PGM/PPM to decode_pnm and Radiance HDR to decode_rgbe
+// (texture/decode.h); GIF, PSD and PIC are refused before decoding.
 #define STBI_NO_JPEG
 #define STBI_NO_PNM
+#define STBI_NO_HDR
 #define STBI_NO_GIF
 #define STBI_NO_PSD
 #define STBI_NO_PIC
@@ -124,7 +125,7 @@ bool Texture::uses_vertex_colors() const {
 
 namespace {
 
-enum class ImageKind { Png, Jpeg, Pnm, Refused, Other };
+enum class ImageKind { Png, Jpeg, Pnm, Rgbe, Refused, Other };
 
 // By magic number, as stb_image and libjpeg recognise them; TGA has none and falls in Other.
 ImageKind image_kind(const std::vector<unsigned char>& b) {
@@ -132,6 +133,7 @@ ImageKind image_kind(const std::vector<unsigned char>& b) {
     if (starts("\x89PNG\r\n\x1a\n", 8)) return ImageKind::Png;
     if (starts("\xFF\xD8\xFF", 3)) return ImageKind::Jpeg;
     if (is_pnm(b)) return ImageKind::Pnm;
+    if (is_rgbe(b)) return ImageKind::Rgbe;
     if (starts("GIF8", 4) || starts("8BPS", 4) || starts("\x53\x80\xF6\x34", 4)) return ImageKind::Refused;
     return ImageKind::Other;
 }
@@ -139,8 +141,8 @@ ImageKind image_kind(const std::vector<unsigned char>& b) {
 // The most texels a file of `bytes` bytes can hold, by format, so that a truncated file claiming a
 // large image is refused before it is decoded (stb_image reads missing bytes as zeros, and decoding
 // hundreds of megatexels from a few bytes takes seconds and gigabytes). PNG: deflate expands at
-// most 1032:1, times 8 one-bit texels a byte. The others stb_image reads (BMP, TGA, HDR)
-// expand at most 64:1 (a TGA run of 128 one-byte texels in 2 bytes; HDR runs give 16).
+// most 1032:1, times 8 one-bit texels a byte. The others stb_image reads (BMP, TGA) expand at most
+// 64:1 (a TGA run of 128 one-byte texels in 2 bytes).
 double max_texels(ImageKind kind, size_t bytes) {
     return (kind == ImageKind::Png ? 1032.0 * 8.0 : 64.0) * double(bytes);
 }
@@ -177,6 +179,9 @@ std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) 
             g->height = t.height;
             g->channels = t.channels;
             to_floats(t.v.data(), 1.f);
+        } else if (kind == ImageKind::Rgbe) {
+            g->channels = 3;
+            g->data = decode_rgbe(path, file, g->width, g->height);  // linear already
         } else {
             const stbi_uc* bytes = file.data();
             const int len = file.size() > size_t(INT32_MAX) ? INT32_MAX : int(file.size());
@@ -198,10 +203,7 @@ std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) 
                 if (!px) throw fail();
                 return std::unique_ptr<std::remove_pointer_t<decltype(px)>, void (*)(void*)>(px, stbi_image_free);
             };
-            if (stbi_is_hdr_from_memory(bytes, len)) {
-                auto px = owned(stbi_loadf_from_memory(bytes, len, &w, &h, &n, want));
-                g->data.assign(px.get(), px.get() + size_t(g->width) * size_t(g->height) * size_t(want));
-            } else if (stbi_is_16_bit_from_memory(bytes, len)) {
+            if (stbi_is_16_bit_from_memory(bytes, len)) {
                 to_floats(owned(stbi_load_16_from_memory(bytes, len, &w, &h, &n, want)).get(), 1.f / 65535.f);
             } else {
                 to_floats(owned(stbi_load_from_memory(bytes, len, &w, &h, &n, want)).get(), 1.f / 255.f);
