@@ -303,62 +303,68 @@ TEST(Texture, MeshAttributeReadsTheVertexColour) {
     EXPECT_NEAR(t.eval_1(q), luminance(q.vertex_color), 1e-7f);
 }
 
+namespace {
+
+// Loading `path` throws one line naming the file and containing `what`.
+void expect_texels_error(const std::string& path, const char* what) {
+    try {
+        load_texels(path, false);
+        ADD_FAILURE() << path << " was accepted";
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find(what), std::string::npos) << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+    }
+}
+
+}  // namespace
+
 TEST(Texture, BadImageFilesAreCleanErrors) {
     const std::string dir = candela::test::temp_dir("texture_bad");
-    auto expect_error = [](const std::string& path, const char* what) {
-        try {
-            load_texels(path, false);
-            ADD_FAILURE() << path << " was accepted";
-        } catch (const Error& e) {
-            const std::string msg = e.what();
-            EXPECT_NE(msg.find(path), std::string::npos) << msg;
-            EXPECT_NE(msg.find(what), std::string::npos) << msg;
-            EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
-        }
-    };
-    expect_error(dir + "/missing.png", "not found");
+    expect_texels_error(dir + "/missing.png", "not found");
     candela::test::write_text(dir + "/garbage.png", "this is not an image at all");
-    expect_error(dir + "/garbage.png", "cannot read image");
+    expect_texels_error(dir + "/garbage.png", "cannot read image");
     // A PNG whose header claims 100000 x 100000 pixels (40 GB as floats).
     const unsigned char header[] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13, 'I', 'H', 'D', 'R',
                                     0, 0x01, 0x86, 0xa0, 0, 0x01, 0x86, 0xa0, 8, 2, 0, 0, 0, 0, 0, 0, 0};
     std::ofstream(dir + "/huge.png", std::ios::binary).write(reinterpret_cast<const char*>(header), sizeof header);
-    expect_error(dir + "/huge.png", "huge.png");
+    expect_texels_error(dir + "/huge.png", "huge.png");
     // A truncated copy of a good PNG.
     std::string good = candela::test::read_bytes(data_file("rgb3x2.png"));
     candela::test::write_text(dir + "/truncated.png", good.substr(0, good.size() / 2));
-    expect_error(dir + "/truncated.png", "truncated.png");
+    expect_texels_error(dir + "/truncated.png", "truncated.png");
     // Fuzzer findings against Debian 12's stb_image JPEG decoder, now refused by libjpeg-turbo or
     // before decoding: Huffman code counts summing to more than 256 (stb wrote past its table), a
     // scan using an undefined table (an undefined shift in stb), and 836 bytes claiming 16386 x
     // 6400 texels (stb decoded 105 megatexels of zeros: 45 s and 1.9 GB under ASan).
-    expect_error(data_file("bad_huffman.jpg"), "Bogus Huffman table");
-    expect_error(data_file("undefined_huffman.jpg"), "Huffman table 0x02 was not defined");
-    expect_error(data_file("claims_16386x6400.jpg"), "JPEG claims 16386x6400 texels, more than its 836 bytes");
+    expect_texels_error(data_file("bad_huffman.jpg"), "Bogus Huffman table");
+    expect_texels_error(data_file("undefined_huffman.jpg"), "Huffman table 0x02 was not defined");
+    expect_texels_error(data_file("claims_16386x6400.jpg"), "JPEG claims 16386x6400 texels, more than its 836 bytes");
     // The same for the formats stb_image still reads: a BMP header claiming 10000 x 10000 texels.
     std::string bmp = "BM" + std::string(52, '\0');
     auto put32 = [&](size_t at, uint32_t v) { for (int k = 0; k < 4; ++k) bmp[at + size_t(k)] = char(v >> (8 * k)); };
     put32(10, 54), put32(14, 40), put32(18, 10000), put32(22, 10000);
     bmp[26] = 1, bmp[28] = 24;
     candela::test::write_text(dir + "/huge.bmp", bmp);
-    expect_error(dir + "/huge.bmp", "image claims 10000x10000 texels, more than its 54 bytes");
+    expect_texels_error(dir + "/huge.bmp", "image claims 10000x10000 texels, more than its 54 bytes");
     // PGM/PPM headers (found by fuzz_image: stb_image's parser overflowed a signed int on a long
     // number); binary PNM is read by decode_pnm now.
     candela::test::write_text(dir + "/long.pgm", "P5 54 6227103515 4  \xcc");
-    expect_error(dir + "/long.pgm", "bad PNM header: height above 1048576");
+    expect_texels_error(dir + "/long.pgm", "bad PNM header: height above 1048576");
     candela::test::write_text(dir + "/short.ppm", "P6 4 4 255\n" + std::string(47, 'x'));
-    expect_error(dir + "/short.ppm", "truncated PNM: 47 bytes of raster, expected 48");
+    expect_texels_error(dir + "/short.ppm", "truncated PNM: 47 bytes of raster, expected 48");
     candela::test::write_text(dir + "/nomax.ppm", "P6 4 4 # no maxval\n");
-    expect_error(dir + "/nomax.ppm", "bad PNM header: no maxval");
+    expect_texels_error(dir + "/nomax.ppm", "bad PNM header: no maxval");
     candela::test::write_text(dir + "/anim.gif", std::string("GIF89a") + std::string(40, '\0'));
-    expect_error(dir + "/anim.gif", "unsupported image format");
+    expect_texels_error(dir + "/anim.gif", "unsupported image format");
     auto jpg = load_texels(data_file("rgb2x2.jpg"), false);
     EXPECT_EQ(jpg->width, 2);
     EXPECT_EQ(jpg->height, 2);
     EXPECT_EQ(jpg->channels, 3);
     // A 2 x 2 PIZ-compressed EXR whose chunk is whole but does not decode (found by fuzz_image:
     // tinyexr 1.0.1 leaked its channel buffers there; the sanitizer build's leak checker sees it).
-    expect_error(data_file("bad_piz.exr"), "cannot decode EXR pixels");
+    expect_texels_error(data_file("bad_piz.exr"), "cannot decode EXR pixels");
 }
 
 // A JPEG written by libjpeg here (64 x 48, colour gradients, quality 100, no chroma subsampling),
@@ -410,14 +416,7 @@ TEST(Texture, JpegDecodesAndTruncatedJpegIsAnError) {
 
         const std::string cut = dir + (progressive ? "/progressive_cut.jpg" : "/baseline_cut.jpg");
         candela::test::write_text(cut, bytes.substr(0, bytes.size() * 2 / 3));
-        try {
-            load_texels(cut, false);
-            ADD_FAILURE() << cut << " was accepted";
-        } catch (const Error& e) {
-            const std::string msg = e.what();
-            EXPECT_NE(msg.find(cut), std::string::npos) << msg;
-            EXPECT_NE(msg.find("Premature end of JPEG file"), std::string::npos) << msg;
-        }
+        expect_texels_error(cut, "Premature end of JPEG file");
     }
 }
 
@@ -480,22 +479,14 @@ TEST(Texture, RgbeDecodesFlatAndRunLength) {
             for (int c = 0; c < 3; ++c)
                 EXPECT_EQ(a->data[3 * size_t(y * w + x) + size_t(c)], std::ldexp(float(texel(x, y, c)), 128 + y - 136));
 
-    auto expect_error = [](const std::string& path, const char* what) {
-        try {
-            load_texels(path, false);
-            ADD_FAILURE() << path << " was accepted";
-        } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-        }
-    };
     candela::test::write_text(dir + "/cut.hdr", header + std::string("\x02\x02\x00\x08", 4));
-    expect_error(dir + "/cut.hdr", "truncated Radiance HDR pixel data");
+    expect_texels_error(dir + "/cut.hdr", "truncated Radiance HDR pixel data");
     candela::test::write_text(dir + "/zero_run.hdr", header + std::string("\x02\x02\x00\x08\x00\x00\x00\x00", 8));
-    expect_error(dir + "/zero_run.hdr", "bad run in scanline 0");
+    expect_texels_error(dir + "/zero_run.hdr", "bad run in scanline 0");
     candela::test::write_text(dir + "/xyz.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 2 +X 8\n");
-    expect_error(dir + "/xyz.hdr", "unsupported Radiance HDR FORMAT=32-bit_rle_xyze");
+    expect_texels_error(dir + "/xyz.hdr", "unsupported Radiance HDR FORMAT=32-bit_rle_xyze");
     candela::test::write_text(dir + "/flipped.hdr", "#?RADIANCE\n\n+Y 2 +X 8\n");
-    expect_error(dir + "/flipped.hdr", "resolution line");
+    expect_texels_error(dir + "/flipped.hdr", "resolution line");
 }
 
 // ---- textured materials in a render, against Mitsuba -------------------------------------------
