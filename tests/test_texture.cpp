@@ -368,8 +368,40 @@ TEST(Texture, BadImageFilesAreCleanErrors) {
 }
 
 // A JPEG written by libjpeg here (64 x 48, colour gradients, quality 100, no chroma subsampling),
-// baseline and progressive, decodes to its source texels within the codec's error, the right way
+// baseline, progressive and arithmetic-coded, decodes to its source texels within the codec's error, the right way
 // up and in RGB order; cut short, it is a one-line error rather than a grey-filled image.
+namespace {
+
+// A JPEG of `src` (RGB, 8 bits, rows from the top) written by libjpeg: quality 100, no chroma
+// subsampling; progressive or arithmetic-coded on request.
+std::string encode_jpeg(const std::vector<uint8_t>& src, int w, int h, bool progressive, bool arith) {
+    jpeg_compress_struct c;
+    jpeg_error_mgr err;
+    c.err = jpeg_std_error(&err);
+    jpeg_create_compress(&c);
+    unsigned char* out = nullptr;
+    unsigned long size = 0;
+    jpeg_mem_dest(&c, &out, &size);
+    c.image_width = JDIMENSION(w), c.image_height = JDIMENSION(h), c.input_components = 3, c.in_color_space = JCS_RGB;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, 100, TRUE);
+    for (int k = 0; k < 3; ++k) c.comp_info[k].h_samp_factor = c.comp_info[k].v_samp_factor = 1;
+    if (progressive) jpeg_simple_progression(&c);
+    c.arith_code = arith;
+    jpeg_start_compress(&c, TRUE);
+    while (c.next_scanline < c.image_height) {
+        JSAMPROW row = const_cast<uint8_t*>(&src[size_t(c.next_scanline) * size_t(w) * 3]);
+        jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    const std::string bytes(reinterpret_cast<const char*>(out), size);
+    jpeg_destroy_compress(&c);
+    std::free(out);
+    return bytes;
+}
+
+}  // namespace
+
 TEST(Texture, JpegDecodesAndTruncatedJpegIsAnError) {
     const std::string dir = candela::test::temp_dir("texture_jpeg");
     const int w = 64, h = 48;
@@ -379,30 +411,11 @@ TEST(Texture, JpegDecodesAndTruncatedJpegIsAnError) {
             uint8_t* p = &src[3 * (size_t(y) * w + x)];
             p[0] = uint8_t(4 * x), p[1] = uint8_t(5 * y), p[2] = uint8_t(200 - 2 * x);
         }
-    for (bool progressive : {false, true}) {
-        jpeg_compress_struct c;
-        jpeg_error_mgr err;
-        c.err = jpeg_std_error(&err);
-        jpeg_create_compress(&c);
-        unsigned char* out = nullptr;
-        unsigned long size = 0;
-        jpeg_mem_dest(&c, &out, &size);
-        c.image_width = w, c.image_height = h, c.input_components = 3, c.in_color_space = JCS_RGB;
-        jpeg_set_defaults(&c);
-        jpeg_set_quality(&c, 100, TRUE);
-        for (int k = 0; k < 3; ++k) c.comp_info[k].h_samp_factor = c.comp_info[k].v_samp_factor = 1;
-        if (progressive) jpeg_simple_progression(&c);
-        jpeg_start_compress(&c, TRUE);
-        while (c.next_scanline < c.image_height) {
-            JSAMPROW row = &src[size_t(c.next_scanline) * w * 3];
-            jpeg_write_scanlines(&c, &row, 1);
-        }
-        jpeg_finish_compress(&c);
-        const std::string bytes(reinterpret_cast<const char*>(out), size);
-        jpeg_destroy_compress(&c);
-        std::free(out);
-
-        const std::string path = dir + (progressive ? "/progressive.jpg" : "/baseline.jpg");
+    // Baseline, progressive, and arithmetic-coded (libjpeg-turbo reads and writes it).
+    const char* name[3] = {"baseline", "progressive", "arithmetic"};
+    for (int kind = 0; kind < 3; ++kind) {
+        const std::string bytes = encode_jpeg(src, w, h, kind == 1, kind == 2);
+        const std::string path = dir + "/" + name[kind] + ".jpg";
         candela::test::write_text(path, bytes);
         auto g = load_texels(path, true);
         ASSERT_EQ(g->width, w);
@@ -414,10 +427,19 @@ TEST(Texture, JpegDecodesAndTruncatedJpegIsAnError) {
         auto lin = load_texels(path, false);  // sRGB-decoded unless raw
         EXPECT_NEAR(lin->data[3 * 10 + 1], srgb_to_linear(g->data[3 * 10 + 1]), 1e-6f);
 
-        const std::string cut = dir + (progressive ? "/progressive_cut.jpg" : "/baseline_cut.jpg");
+        const std::string cut = dir + "/" + name[kind] + "_cut.jpg";
         candela::test::write_text(cut, bytes.substr(0, bytes.size() * 2 / 3));
         expect_texels_error(cut, "Premature end of JPEG file");
     }
+    // A flat 1024 x 1024 image, arithmetic-coded, takes far less than a bit a block: the bound of
+    // 512 texels a byte (Huffman files) must not refuse it.
+    const std::vector<uint8_t> flat(size_t(1024) * 1024 * 3, 100);
+    const std::string small = encode_jpeg(flat, 1024, 1024, false, true);
+    EXPECT_GT(1024.0 * 1024.0, 512.0 * double(small.size())) << "the file is not small enough to test the bound";
+    candela::test::write_text(dir + "/flat_arithmetic.jpg", small);
+    auto f = load_texels(dir + "/flat_arithmetic.jpg", true);
+    EXPECT_EQ(f->width, 1024);
+    EXPECT_NEAR(f->data[3 * 1000 + 2], 100.f / 255.f, 1e-6f);
 }
 
 // Binary PGM and PPM: comments in the header, 8 and 16 bits (big-endian), values over maxval,

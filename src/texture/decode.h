@@ -18,8 +18,9 @@ struct EncodedTexels {
 // or CMYK file, and before decoding one whose header claims more texels than its bytes can hold.
 EncodedTexels decode_jpeg(const std::string& path, const std::vector<unsigned char>& file);
 
-// The most texels a JPEG of `bytes` bytes can code: each 8 x 8 block of the fullest component
-// costs at least one bit (its DC code, in a baseline or a progressive file), so 512 texels a byte.
+// The most texels a Huffman-coded JPEG of `bytes` bytes can code: each 8 x 8 block of the fullest
+// component costs at least one bit (its DC code, in a baseline or a progressive file), so 512
+// texels a byte. (Arithmetic-coded files, rare, are bounded by kMaxTexels and the end of file.)
 inline double jpeg_max_texels(size_t bytes) { return 512.0 * double(bytes); }
 
 // Decodes a binary PGM (P5) or PPM (P6) held in memory: 1 or 2 bytes a sample (big-endian) by

@@ -68,7 +68,8 @@ Outcome decode_into(const std::vector<unsigned char>& file, ErrorManager& err, E
     Outcome refused = Outcome::Ok;
     if (cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK) refused = Outcome::Cmyk;
     const double texels = double(cinfo.image_width) * double(cinfo.image_height);
-    if (texels > jpeg_max_texels(file.size())) refused = Outcome::Truncated;
+    // Arithmetic coding can spend less than a bit on a block, so only Huffman files are bounded.
+    if (!cinfo.arith_code && texels > jpeg_max_texels(file.size())) refused = Outcome::Truncated;
     if (texels > double(kMaxTexels)) refused = Outcome::Huge;
     out.width = int(cinfo.image_width);
     out.height = int(cinfo.image_height);
