@@ -5,7 +5,6 @@
 #include <jpeglib.h>
 #include <jerror.h>
 #include "core/error.h"
-#include "texture/texture.h"  // kMaxTexels
 
 namespace candela {
 
@@ -44,12 +43,12 @@ void progress(j_common_ptr cinfo) {
     }
 }
 
-enum class Outcome { Ok, LibjpegError, Huge, Truncated, Cmyk, NoMemory };
+enum class Outcome { Ok, LibjpegError, Size, Cmyk, NoMemory };
 
 // No object with a destructor lives in this frame, so libjpeg's longjmp back to it is well
 // defined; `out` belongs to the caller and is only resized between libjpeg calls.
 Outcome decode_into(const std::vector<unsigned char>& file, ErrorManager& err, EncodedTexels& out,
-                    std::vector<unsigned char>& rowbuf) {
+                    std::vector<unsigned char>& rowbuf, double& per_byte) {
     jpeg_decompress_struct cinfo;
     jpeg_progress_mgr monitor;
     cinfo.err = jpeg_std_error(&err.mgr);
@@ -67,10 +66,9 @@ Outcome decode_into(const std::vector<unsigned char>& file, ErrorManager& err, E
     jpeg_read_header(&cinfo, TRUE);
     Outcome refused = Outcome::Ok;
     if (cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK) refused = Outcome::Cmyk;
-    const double texels = double(cinfo.image_width) * double(cinfo.image_height);
     // Arithmetic coding can spend less than a bit on a block, so only Huffman files are bounded.
-    if (!cinfo.arith_code && texels > jpeg_max_texels(file.size())) refused = Outcome::Truncated;
-    if (texels > double(kMaxTexels)) refused = Outcome::Huge;
+    per_byte = cinfo.arith_code ? 0.0 : kJpegTexelsPerByte;
+    if (!image_size_ok(cinfo.image_width, cinfo.image_height, file.size(), per_byte)) refused = Outcome::Size;
     out.width = int(cinfo.image_width);
     out.height = int(cinfo.image_height);
     if (refused != Outcome::Ok) {
@@ -105,21 +103,18 @@ EncodedTexels decode_jpeg(const std::string& path, const std::vector<unsigned ch
     ErrorManager err;
     EncodedTexels out;
     std::vector<unsigned char> rowbuf;
-    switch (decode_into(file, err, out, rowbuf)) {
+    double per_byte = 0.0;
+    switch (decode_into(file, err, out, rowbuf, per_byte)) {
         case Outcome::Ok: return out;
         case Outcome::LibjpegError: throw Error(path, 0, std::string("cannot decode JPEG: ") + err.message);
         case Outcome::Cmyk: throw Error(path, 0, "CMYK JPEG images are not supported (save it as RGB)");
         case Outcome::NoMemory:
             throw Error(path, 0, "out of memory decoding a " + std::to_string(out.width) + "x" +
                                      std::to_string(out.height) + " JPEG");
-        case Outcome::Huge:
-            throw Error(path, 0, "image size " + std::to_string(out.width) + "x" + std::to_string(out.height) +
-                                     " is not supported");
-        case Outcome::Truncated: break;
+        case Outcome::Size: break;
     }
-    throw Error(path, 0, "JPEG claims " + std::to_string(out.width) + "x" + std::to_string(out.height) +
-                             " texels, more than its " + std::to_string(file.size()) +
-                             " bytes can code (truncated or corrupt)");
+    check_image_size(path, "JPEG", out.width, out.height, file.size(), per_byte);
+    throw Error(path, 0, "internal error: JPEG size refused without a reason");
 }
 
 }  // namespace candela

@@ -2,7 +2,6 @@
 #include <cstdint>
 #include "core/error.h"
 #include "texture/decode.h"
-#include "texture/texture.h"  // kMaxTexels
 
 // Binary PGM and PPM (netpbm's P5 and P6), read here rather than by stb_image, whose header parser
 // overflows a signed int on a long number (a fuzzer finding).
@@ -37,8 +36,7 @@ EncodedTexels decode_pnm(const std::string& path, const std::vector<unsigned cha
     t.channels = f[1] == '5' ? 1 : 3;
     const long long w = number("width", 1 << 20), h = number("height", 1 << 20), maxval = number("maxval", 65535);
     if (w == 0 || h == 0 || maxval == 0) throw Error(path, 0, "bad PNM header: zero width, height or maxval");
-    if (w * h > kMaxTexels)
-        throw Error(path, 0, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not supported");
+    check_image_size(path, "image", w, h, f.size(), 0);  // the raster's length is checked below
     // Exactly one whitespace character separates the header from the raster.
     if (pos >= f.size() || !std::isspace(f[pos])) throw Error(path, 0, "truncated PNM header");
     ++pos;

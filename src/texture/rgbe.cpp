@@ -5,7 +5,6 @@
 #include <cstring>
 #include "core/error.h"
 #include "texture/decode.h"
-#include "texture/texture.h"  // kMaxTexels
 
 // Radiance RGBE (.hdr), read here rather than by Debian 12's stb_image, which loops forever on a
 // run-length scanline cut short (it reads the missing bytes as zero-length runs; CVE-2021-42715).
@@ -39,12 +38,8 @@ std::vector<float> decode_rgbe(const std::string& path, const std::vector<unsign
     if (std::sscanf(res.c_str(), "-Y %ld +X %ld", &h, &w) != 2)
         throw Error(path, 0, "unsupported Radiance HDR resolution line (only \"-Y height +X width\" is read): " +
                                  res.substr(0, 64));
-    if (w <= 0 || h <= 0 || w > (1 << 20) || h > (1 << 20) || double(w) * double(h) > double(kMaxTexels))
-        throw Error(path, 0, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not supported");
     // Run-length data codes at most 127 values of a channel in 2 bytes, 4 channels a texel.
-    if (double(w) * double(h) > 16.0 * double(f.size()))
-        throw Error(path, 0, "image claims " + std::to_string(w) + "x" + std::to_string(h) + " texels, more than its " +
-                                 std::to_string(f.size()) + " bytes can hold (truncated or corrupt)");
+    check_image_size(path, "image", w, h, f.size(), 16.0);
     width = int(w);
     height = int(h);
     std::vector<float> rgb(size_t(w) * size_t(h) * 3);

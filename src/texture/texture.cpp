@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <memory>
 #include <type_traits>
-#include <climits>
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
@@ -138,16 +137,26 @@ ImageKind image_kind(const std::vector<unsigned char>& b) {
     return ImageKind::Other;
 }
 
-// The most texels a file of `bytes` bytes can hold, by format, so that a truncated file claiming a
-// large image is refused before it is decoded (stb_image reads missing bytes as zeros, and decoding
-// hundreds of megatexels from a few bytes takes seconds and gigabytes). PNG: deflate expands at
-// most 1032:1, times 8 one-bit texels a byte. The others stb_image reads (BMP, TGA) expand at most
-// 64:1 (a TGA run of 128 one-byte texels in 2 bytes).
-double max_texels(ImageKind kind, size_t bytes) {
-    return (kind == ImageKind::Png ? 1032.0 * 8.0 : 64.0) * double(bytes);
-}
+// The most texels a byte of a file stb_image reads can hold (check_image_size). PNG: deflate
+// expands at most 1032:1, times 8 one-bit texels a byte. BMP and TGA expand at most 64:1 (a TGA
+// run of 128 one-byte texels in 2 bytes).
+double texels_per_byte(ImageKind kind) { return kind == ImageKind::Png ? 1032.0 * 8.0 : 64.0; }
 
 }  // namespace
+
+bool image_size_ok(long long w, long long h, size_t bytes, double texels_per_byte) {
+    const double texels = double(w) * double(h);
+    return w > 0 && h > 0 && texels <= double(kMaxTexels) && (texels_per_byte <= 0 || texels <= texels_per_byte * double(bytes));
+}
+
+void check_image_size(const std::string& path, const char* format, long long w, long long h, size_t bytes,
+                      double texels_per_byte) {
+    if (image_size_ok(w, h, bytes, texels_per_byte)) return;
+    const std::string size = std::to_string(w) + "x" + std::to_string(h);
+    if (!image_size_ok(w, h, bytes, 0)) throw Error(path, 0, "image size " + size + " is not supported");
+    throw Error(path, 0, std::string(format) + " claims " + size + " texels, more than its " + std::to_string(bytes) +
+                             " bytes can hold (truncated or corrupt)");
+}
 
 std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) {
     std::error_code ec;
@@ -188,12 +197,7 @@ std::shared_ptr<const TexelGrid> load_texels(const std::string& path, bool raw) 
             int w = 0, h = 0, n = 0;
             if (!stbi_info_from_memory(bytes, len, &w, &h, &n))
                 throw Error(path, 0, std::string("cannot read image: ") + stbi_failure_reason());
-            const double texels = double(w) * double(h);
-            if (w <= 0 || h <= 0 || texels > double(kMaxTexels))
-                throw Error(path, 0, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not supported");
-            if (texels > max_texels(kind, file.size()))
-                throw Error(path, 0, "image claims " + std::to_string(w) + "x" + std::to_string(h) + " texels, more than its " +
-                                         std::to_string(file.size()) + " bytes can hold (truncated or corrupt)");
+            check_image_size(path, "image", w, h, file.size(), texels_per_byte(kind));
             const int want = (n == 1 || n == 2) ? 1 : 3;  // grey (+alpha) or colour (+alpha); alpha dropped
             g->width = w;
             g->height = h;
