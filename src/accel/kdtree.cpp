@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <unordered_map>
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "geometry/triangle.h"
@@ -292,6 +293,7 @@ private:
 void KdTree::interrupted_build() {
     nodes_.clear();
     blocks_.clear();
+    root_leaf_ = false;
     bounds_ = AABB();
     stats_ = {};
 }
@@ -299,6 +301,7 @@ void KdTree::interrupted_build() {
 void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AABB* clip, const KdBuildOptions& opt) {
     nodes_.clear();
     blocks_.clear();
+    root_leaf_ = false;
     bounds_ = AABB();
     stats_ = {};
 
@@ -349,18 +352,52 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
     }
     if (interrupt_requested()) return interrupted_build();
 
-    // Layout: the two children of a node are adjacent (a sibling pair), so an interior node stores
-    // one index. Pairs are packed in treelets of up to 4 pairs (8 nodes, 64 bytes), filled breadth
-    // first: a pair, its children's pairs, one more. A ray descending through a treelet's 2-3
-    // levels then touches one or two cache lines instead of one per level, which is what
-    // incoherent rays pay for: the deep levels are never in cache. Treelets follow each other in
-    // depth-first order, and so do the leaves' triangle blocks.
-    struct Flatten {
+    // Layout: the binary tree collapsed into nodes of up to eight children (KdTree::WideNode),
+    // depth first, each leaf's triangles as blocks of eight right after the node that reaches it.
+    // First the box of every subtree: the cells split top down, each leaf's cell clipped to the
+    // part of its triangles inside it; a subtree's box is the union of its leaves'. Then each node
+    // takes its non-empty children and opens the interior child with the largest box while the
+    // children still fit in eight lanes (a k-d tree collapsed as Embree collapses a binary BVH).
+    struct Collapse {
         KdTree& t;
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
-        // Appends the leaf's triangles as blocks of kBlockLanes (the last triangle repeated to fill
-        // a block).
+        std::unordered_map<const BuildNode*, AABB> box;
+
+        AABB boxes(const BuildNode* n, const AABB& cell, int depth) {
+            t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
+            ++t.stats_.nodes;
+            AABB b;
+            if (n->axis < 0) {
+                ++t.stats_.leaves;
+                t.stats_.references += n->prims.size();
+                if (n->prims.empty()) ++t.stats_.empty_leaves;
+                // Where the clipping finds nothing (a triangle only touching the cell), the cell
+                // clipped to the triangle's bounds: still around the touching part.
+                for (uint32_t p : n->prims) {
+                    vec3 v[3];
+                    mesh.vertices(list[p], v[0], v[1], v[2]);
+                    AABB c = clipped_bounds(v, cell);
+                    if (c.empty()) {
+                        for (const vec3& q : v) c.expand(q);
+                        c.min = glm::max(c.min, cell.min);
+                        c.max = glm::min(c.max, cell.max);
+                    }
+                    b.expand(c);
+                }
+            } else {
+                AABB lo = cell, hi = cell;
+                lo.max[n->axis] = n->split;
+                hi.min[n->axis] = n->split;
+                b = boxes(n->child[0].get(), lo, depth + 1);
+                b.expand(boxes(n->child[1].get(), hi, depth + 1));
+            }
+            box[n] = b;
+            return b;
+        }
+        bool holds(const BuildNode* n) const { return n->axis < 0 ? !n->prims.empty() : !box.at(n).empty(); }
+        // Appends a leaf's triangles as blocks of kBlockLanes (the last triangle repeated to fill
+        // the last block).
         uint32_t add_blocks(const std::vector<uint32_t>& prims) {
             constexpr size_t kLanes = KdTree::kBlockLanes;
             const uint32_t first = uint32_t(t.blocks_.size());
@@ -378,72 +415,75 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             }
             return first;
         }
-        // Writes a leaf, or an interior node whose children index is patched when its pair is placed.
-        void write(uint32_t idx, const BuildNode* bn, int depth) {
-            t.stats_.max_depth = std::max(t.stats_.max_depth, depth);
-            Node& nd = t.nodes_[idx];
-            if (bn->axis >= 0) {
-                nd.split = bn->split;
-                nd.bits = uint32_t(bn->axis);
-                return;
-            }
-            const size_t n = bn->prims.size();
-            const uint32_t first = n > 0 ? add_blocks(bn->prims) : 0;
-            t.nodes_[idx].first = first;
-            t.nodes_[idx].bits = (uint32_t(n) << 2) | 3u;
-            ++t.stats_.leaves;
-            t.stats_.references += n;
-            if (n == 0) ++t.stats_.empty_leaves;
-        }
-        struct Pair {
-            const BuildNode* parent;  // its two children form the pair
-            uint32_t parent_idx;
-            int depth;                // of the children
-        };
-        void run(const BuildNode& root) {
+        uint32_t make(const BuildNode* n) {
+            constexpr size_t kLanes = KdTree::kBlockLanes;
+            if (t.nodes_.size() >= KdTree::kMaxNodes || t.blocks_.size() >= KdTree::kMaxNodes)
+                throw Error("k-d tree: more than 2^31 nodes or triangle blocks");
+            const uint32_t idx = uint32_t(t.nodes_.size());
             t.nodes_.emplace_back();
-            write(0, &root, 0);
-            if (root.axis < 0) return;
-            std::vector<Pair> work{{&root, 0, 1}};
-            Pair q[8];
-            while (!work.empty()) {
-                int qn = 0, qi = 0, placed = 0;
-                q[qn++] = work.back();
-                work.pop_back();
-                const size_t mark = work.size();
-                while (qi < qn) {
-                    const Pair p = q[qi++];
-                    if (placed == 4) {  // the treelet is full: the rest starts treelets of its own
-                        work.push_back(p);
-                        continue;
-                    }
-                    ++placed;
-                    const uint32_t c = uint32_t(t.nodes_.size());
-                    if (c + 2 > KdTree::kMaxNodes) throw Error("k-d tree: more than 2^28 nodes");
-                    t.nodes_.emplace_back();
-                    t.nodes_.emplace_back();
-                    t.nodes_[p.parent_idx].bits |= c << 4;
-                    for (int k = 0; k < 2; ++k) {
-                        const BuildNode* ch = p.parent->child[k].get();
-                        if (ch->axis < 0 && ch->prims.empty()) t.nodes_[p.parent_idx].bits |= 4u << k;
-                        write(c + uint32_t(k), ch, p.depth);
-                        if (ch->axis >= 0 && qn < 8) q[qn++] = {ch, c + uint32_t(k), p.depth + 1};
-                        else if (ch->axis >= 0) work.push_back({ch, c + uint32_t(k), p.depth + 1});
+            std::vector<const BuildNode*> kids;
+            if (n->axis < 0) {
+                if (holds(n)) kids.push_back(n);
+            } else {
+                for (const auto& c : n->child)
+                    if (holds(c.get())) kids.push_back(c.get());
+            }
+            for (;;) {
+                int best = -1;
+                float best_area = -1.f;
+                for (size_t i = 0; i < kids.size(); ++i) {
+                    const BuildNode* c = kids[i];
+                    if (c->axis < 0) continue;
+                    const size_t grow = size_t(holds(c->child[0].get())) + size_t(holds(c->child[1].get()));
+                    if (kids.size() - 1 + grow > kLanes) continue;
+                    const float area = box.at(c).surface_area();
+                    if (area > best_area) {
+                        best_area = area;
+                        best = int(i);
                     }
                 }
-                // Depth first between treelets: the pairs just deferred are taken first, in order.
-                std::reverse(work.begin() + ptrdiff_t(mark), work.end());
+                if (best < 0) break;
+                const BuildNode* c = kids[size_t(best)];
+                kids.erase(kids.begin() + best);
+                for (const auto& g : c->child)
+                    if (holds(g.get())) kids.push_back(g.get());
             }
+            WideNode w;
+            for (int a = 0; a < 3; ++a)
+                for (size_t k = 0; k < kLanes; ++k) {
+                    w.lo[a][k] = kInfinity;
+                    w.hi[a][k] = -kInfinity;
+                }
+            for (size_t k = 0; k < kLanes; ++k) w.child[k] = w.count[k] = 0;
+            for (size_t k = 0; k < kids.size(); ++k) {
+                const AABB& b = box.at(kids[k]);
+                for (int a = 0; a < 3; ++a) {
+                    w.lo[a][k] = b.min[a];
+                    w.hi[a][k] = b.max[a];
+                }
+                if (kids[k]->axis < 0) {
+                    w.child[k] = add_blocks(kids[k]->prims);
+                    w.count[k] = uint32_t(kids[k]->prims.size());
+                } else {
+                    w.child[k] = make(kids[k]);
+                    w.count[k] = kWideInterior;
+                }
+            }
+            t.nodes_[idx] = w;  // by index: make() above may have moved the vector
+            return idx;
         }
     };
-    Flatten{*this, mesh, list}.run(*root);
+    Collapse c{*this, mesh, list, {}};
+    c.boxes(root.get(), bounds_, 0);
+    c.make(root.get());
+    root_leaf_ = root->axis < 0;
     nodes_.shrink_to_fit();
     blocks_.shrink_to_fit();
-    stats_.nodes = nodes_.size();
+    stats_.wide_nodes = nodes_.size();
 }
 
 size_t KdTree::memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + blocks_.capacity() * sizeof(TriBlock);
+    return nodes_.capacity() * sizeof(WideNode) + blocks_.capacity() * sizeof(TriBlock);
 }
 
 KdTraceCounters& kd_trace_counters() {

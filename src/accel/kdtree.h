@@ -7,13 +7,17 @@
 // splits it into the children's lists without re-sorting (only the few straddling triangles are
 // clipped and their new events sorted and merged). Subtrees are built in parallel (OpenMP tasks).
 //
-// Traversal (kdtree_trace.cpp): 8-byte nodes, a fixed-size stack, a template <bool Shadow> for the
-// any-hit variant, compiled per SIMD target (Highway) and chosen at run time. Leaves hold their
-// triangles' vertices in blocks of eight, laid out for the triangle test's vector lanes (a copy
-// per leaf reference): one 8-lane step on AVX2, two 4-lane steps on SSE4 and NEON. Every triangle
-// test is the watertight intersect_triangle() on the mesh's own vertex values, so a hit has the
-// same t, bit for bit, as the brute-force oracle. Zero-area triangles, which it never hits, are
-// left out at build.
+// Layout and traversal (kdtree_trace.cpp): the binary tree is collapsed into nodes of up to eight
+// children, each boxed by what it holds, so that one vector step (8 lanes on AVX2, two of 4 on
+// SSE4 and NEON) tests a node's children and a ray takes a few wide steps where it took some 27
+// binary ones; the SAH build, the leaves and the exact triangle test are the k-d tree's. Empty
+// leaves vanish. Traversal keeps a fixed stack, visits the children hit nearest first and skips
+// those beyond the closest hit; a template <bool Shadow> is the any-hit variant. It is compiled
+// per SIMD target (Highway) and chosen at run time. Leaves hold their triangles' vertices in
+// blocks of eight, laid out for the triangle test's lanes (a copy per leaf reference). Every
+// triangle test is the watertight intersect_triangle() on the mesh's own vertex values, so a hit
+// has the same t, bit for bit, as the brute-force oracle. Zero-area triangles, which it never
+// hits, are left out at build.
 #include <cstdint>
 #include <vector>
 #include "accel/accel.h"
@@ -37,7 +41,8 @@ struct KdBuildOptions {
 };
 
 struct KdTreeStats {
-    size_t nodes = 0, leaves = 0, empty_leaves = 0, references = 0;
+    size_t nodes = 0, leaves = 0, empty_leaves = 0, references = 0;  // of the binary tree built
+    size_t wide_nodes = 0;                                             // after collapsing it
     int max_depth = 0;
 };
 
@@ -51,8 +56,8 @@ KdTraceCounters& kd_trace_counters();
 // The tree itself, without the Accel vtable: the hybrid grid holds one per cell.
 class KdTree {
 public:
-    static constexpr int kMaxDepth = 60;  // the traversal stack holds kMaxDepth + 4 entries
-    static constexpr uint32_t kMaxNodes = 1u << 28;  // node indices have 28 bits
+    static constexpr int kMaxDepth = 60;  // of the binary tree; bounds the traversal stack
+    static constexpr uint32_t kMaxNodes = 1u << 31;  // wide nodes, and triangle blocks
 
     KdTree() = default;
     // Builds over triangles `tris` of `mesh` (all of them when tris is null). When `clip` is given,
@@ -73,28 +78,6 @@ public:
     size_t memory_bytes() const;
     const KdTreeStats& stats() const { return stats_; }
 
-    // Compact node: an interior node keeps the split position and the index of its first child
-    // ("below" the plane; the "above" child follows it: siblings are adjacent). A leaf keeps its
-    // triangle count and `first`, the index of its first TriBlock.
-    struct Node {
-        union {
-            float split;
-            uint32_t first;
-        };
-        // Low 2 bits: axis 0-2, or 3 for a leaf. A leaf keeps its count in the high 30 bits; an
-        // interior node keeps two flags, "below is an empty leaf" (bit 2) and "above is an empty
-        // leaf" (bit 3), and its first child's index in the high 28 bits. The flags let a ray
-        // skip an empty child without loading it or stacking it: about half of the leaves are
-        // empty (the SAH cuts empty space off), and a ray leaving a surface crosses several.
-        uint32_t bits;
-        bool leaf() const { return (bits & 3u) == 3u; }
-        int axis() const { return int(bits & 3u); }
-        uint32_t children() const { return bits >> 4; }
-        uint32_t empty_child(int k) const { return (bits >> (2 + k)) & 1u; }  // k: 0 below, 1 above
-        uint32_t count() const { return bits >> 2; }
-    };
-    static_assert(sizeof(Node) == 8, "k-d tree nodes are 8 bytes");
-
     // Eight triangles of a leaf, vertex coordinates by axis and lane (v[vertex][axis][lane]), so
     // that the SIMD filter loads them as they are (8 lanes, or two halves of 4); a leaf holds
     // ceil(count / 8) blocks, the last triangle repeated to fill the last one.
@@ -105,11 +88,25 @@ public:
     };
     static_assert(sizeof(TriBlock) == 320, "a block is 8 triangles");
 
+    // Up to eight subtrees (or leaves) of the binary tree as one node, each child boxed by what
+    // it holds: the union over its leaves of the part of their triangles inside their cells
+    // (clipped, rounded outwards). Boxes by axis and lane (lo[axis][lane]), so that one 8-lane
+    // step (two of 4) tests them all; an unused lane has an empty box (+inf, -inf), which no ray
+    // enters. Node 0 is the root.
+    static constexpr uint32_t kWideInterior = 0xffffffffu;
+    struct alignas(32) WideNode {
+        float lo[3][kBlockLanes], hi[3][kBlockLanes];
+        uint32_t child[kBlockLanes];  // a WideNode index, or a leaf's first TriBlock
+        uint32_t count[kBlockLanes];  // kWideInterior, or the leaf's triangle count (0: unused lane)
+    };
+    static_assert(sizeof(WideNode) == 256, "a wide node is four cache lines");
+
 private:
     void interrupted_build();
 
-    std::vector<Node> nodes_;
+    std::vector<WideNode> nodes_;
     std::vector<TriBlock> blocks_;  // the leaves' triangles, leaf by leaf
+    bool root_leaf_ = false;        // the tree is one leaf: its box test is the root box's
     AABB bounds_;
     KdTreeStats stats_;
 };

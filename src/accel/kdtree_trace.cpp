@@ -1,11 +1,12 @@
-// K-d tree traversal (KdTree::intersect and KdTree::occluded) with its SIMD triangle test.
+// K-d tree traversal (KdTree::intersect and KdTree::occluded): the collapsed tree's nodes of eight
+// child boxes (KdTree::WideNode), each tested in one vector step, and the SIMD triangle test.
 //
 // The SIMD is Google Highway, compiled once per instruction set that the target architecture
 // offers (foreach_target: SSSE3, SSE4, AVX2 on x86; NEON and SVE on aarch64; a scalar fallback
 // everywhere) and chosen at run time for the CPU, once per ray (HWY_DYNAMIC_DISPATCH: one indirect
 // call, like the Accel's virtual one). Runtime dispatch: static dispatch at the x86-64 baseline
-// would get Highway 1.0.3's scalar fallback. A leaf block holds 8 triangles (KdTree::TriBlock):
-// AVX2 tests them in one step of 8 lanes, the 128-bit targets (SSSE3, SSE4, NEON, and SVE, whose
+// would get Highway 1.0.3's scalar fallback. A node holds 8 boxes and a leaf block 8 triangles
+// (KdTree::TriBlock): AVX2 tests them in one step of 8 lanes, the 128-bit targets (SSSE3, SSE4, NEON, and SVE, whose
 // vectors may be no wider) in two steps of 4, the scalar fallback in 8 steps of 1.
 // docs/accel.md has the measurements.
 //
@@ -17,6 +18,7 @@
 
 #include "accel/kdtree.h"
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include "core/math.h"
 #include "geometry/triangle.h"
@@ -64,16 +66,14 @@ constexpr int kStepWanted = 4;
 using DL = hn::CappedTag<float, kStepWanted>;
 using VL = hn::Vec<DL>;
 using ML = hn::Mask<DL>;
-using D1 = hn::CappedTag<float, 1>;  // one float, for branch-free selects in the walk from the origin
-using V1 = hn::Vec<D1>;
 constexpr int kStep = int(hn::MaxLanes(DL()));
 constexpr int kLanes = KdTree::kBlockLanes;
 static_assert(kStep == kStepWanted && kLanes % kStep == 0, "a block is a whole number of vectors");
 constexpr unsigned kStepMask = (1u << kStep) - 1u;
 
-// Widening of a ray parameter by 2^-16 of its size: room for the rounding of split-plane
-// distances and of triangle hit distances (both a few ulps) so that the traversal never culls a
-// node that brute force would find a hit in. The traversal keeps every parameter >= 0 (hits have
+// Widening of a ray parameter by 2^-16 of its size: room for the rounding of box-plane distances
+// and of triangle hit distances (both a few ulps) so that the traversal never culls a child that
+// brute force would find a hit in. The traversal keeps every entry distance >= 0 (hits have
 // t > 0), so a single multiplication widens.
 constexpr float kWidenUp = 1.f + 1.f / 65536.f;
 constexpr float kWidenDown = 1.f - 1.f / 65536.f;
@@ -81,10 +81,9 @@ constexpr float kWidenDown = 1.f - 1.f / 65536.f;
 // Per-ray constants in plain arrays: glm's operator[] is a switch, slow in the node loop.
 struct RayData {
     float o[3], inv_d[3];
-    bool d_nonpos[3];  // d <= 0: a ray starting on a split plane goes below first
-    // The origin as compared with split planes: o_above[a] > split exactly when the origin lies
-    // above the plane, or on it moving up (o rounded up to the next float when d > 0).
-    float o_above[3];
+    // The sign bit of d (and so of inv_d: 1 / -0 = -inf): a box's near plane on that axis is its
+    // upper one. Not d < 0, which would pair d = -0 with the lower plane and an inv_d of -inf.
+    bool d_neg[3];
     int kx, ky, kz;  // the shear of intersect_triangle (RayShear), for the SIMD filter
     float sx, sy, sz;
     RayData(const Ray& ray, const RayShear& sh) {
@@ -97,8 +96,7 @@ struct RayData {
         for (int i = 0; i < 3; ++i) {
             o[i] = ray.o[i];
             inv_d[i] = 1.f / ray.d[i];
-            d_nonpos[i] = ray.d[i] <= 0.f;
-            o_above[i] = d_nonpos[i] ? o[i] : next_float_up(o[i]);
+            d_neg[i] = std::signbit(ray.d[i]);
         }
     }
 };
@@ -218,162 +216,168 @@ inline unsigned triangle_hits(const RayData& r, const KdTree::TriBlock& b, float
     return hits;
 }
 
+// The triangles of a leaf (`count` of them from block `b`) against the ray: records a closer hit
+// in ray.tmax, `tmax`, *hit and `found`; with Shadow, returns true at the first hit.
 template <bool Shadow>
-bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB& bounds, Ray& ray, Hit* hit) {
-    constexpr int kMaxDepth = KdTree::kMaxDepth;
-    using Node = KdTree::Node;
-    using TriBlock = KdTree::TriBlock;
+inline bool test_leaf(const RayData& r, const RayShear& sh, const KdTree::TriBlock* b, uint32_t count, Ray& ray, Hit* hit,
+                      float& tmax, bool& found) {
+    KD_COUNT(tris, count);
+    auto record = [&](float t, float b1, float b2, uint32_t prim) {
+        tmax = t;
+        ray.tmax = t;
+        hit->t = t;
+        hit->b1 = b1;
+        hit->b2 = b2;
+        hit->prim = prim;
+        found = true;
+    };
+    for (uint32_t i = 0; i < count; i += kLanes, ++b) {
+        const uint32_t n = std::min(count - i, uint32_t(kLanes));
+        unsigned scalar;
+        BlockHits bh;
+        const unsigned hits = triangle_hits(r, *b, ray.tmin, ray.tmax, (1u << n) - 1u, scalar, bh);
+        if (Shadow && hits) return true;
+        // In lane order, as the scalar test would meet them: a later lane replaces an earlier hit
+        // only when strictly closer. Lanes with an edge function exactly 0 go to the shared scalar
+        // test (its double fallback), so every hit is bit-identical to brute force.
+        for (unsigned m = hits | scalar; m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            if (scalar >> k & 1u) {
+                TriangleHit th;
+                const vec3 p0(b->v[0][0][k], b->v[0][1][k], b->v[0][2][k]);
+                const vec3 p1(b->v[1][0][k], b->v[1][1][k], b->v[1][2][k]);
+                const vec3 p2(b->v[2][0][k], b->v[2][1][k], b->v[2][2][k]);
+                if (!intersect_triangle(ray, sh, p0, p1, p2, th)) continue;
+                if constexpr (Shadow) return true;
+                record(th.t, th.b1, th.b2, b->prim[k]);
+            } else if constexpr (!Shadow) {
+                if (bh.t[k] < ray.tmax) record(bh.t[k], bh.b1[k], bh.b2[k], b->prim[k]);
+            }
+        }
+    }
+    return false;
+}
+
+// Slab test of a ray against kStep boxes: narrows [tnear, tfar] by one axis. A NaN distance
+// ((plane - o) * inf = 0 * inf, a ray lying in a box's plane) fails both comparisons and so never
+// narrows the interval: the ray is then inside the slab, as it should be.
+inline void slab(const DL d, const float* near_plane, const float* far_plane, VL o, VL inv, VL& tnear, VL& tfar) {
+    const VL tn = hn::Mul(hn::Sub(hn::Load(d, near_plane), o), inv);
+    const VL tf = hn::Mul(hn::Sub(hn::Load(d, far_plane), o), inv);
+    tnear = hn::IfThenElse(hn::Gt(tn, tnear), tn, tnear);
+    tfar = hn::IfThenElse(hn::Lt(tf, tfar), tf, tfar);
+}
+
+// Closest hit (any hit with Shadow) in the collapsed tree. A node's eight child boxes are tested
+// in one vector step (two of four); the children hit are stacked with their entry distances,
+// farthest first, so that the nearest is taken next, and a stacked child that starts beyond the
+// closest hit found is skipped. With Shadow the order is the lanes': any hit ends the walk. When
+// the whole tree is one leaf (`leaf_root`: its box), the root box's scalar test stands for the
+// vector step.
+template <bool Shadow>
+bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const AABB* leaf_root, Ray& ray, Hit* hit) {
     KD_COUNT(rays, 1);
     const RayShear sh(ray.d);
     const RayData r(ray, sh);
-    float t0, t1;
-    if (!bounds.intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
-    t0 = std::max(t0, 0.f);  // no hit has t <= 0 (intersect_triangle's error bound)
-    if (!(t0 <= t1)) return false;
-
-    // The stack of nodes still to visit with their intervals, as three arrays: single stores.
-    const Node* st_node[kMaxDepth + 4];
-    float st_t0[kMaxDepth + 4], st_t1[kMaxDepth + 4];
-    int sp = 0;
-    const Node* node = nodes;
     float tmax = ray.tmax;
     bool found = false;
-    if (t0 == 0.f) {
-        // The segment starts at the origin (inside the root box): every node on the way down
-        // holds the origin, so the next node is always the child on the origin's side (the exact
-        // test of the general step below), and the other child is pushed when the ray reaches the
-        // plane inside the segment. The general step visits the same nodes with the same
-        // intervals, but its branches on tp mispredict here, so this walk (half of a bounce or
-        // shadow ray's node visits) is written without branches on tp: flag arithmetic, a scalar
-        // min (minss) and two one-lane vector selects (docs/accel.md has the measurements).
-        const D1 d1;
-        const V1 inf1 = hn::Set(d1, kInfinity), zero1 = hn::Zero(d1);
-        const V1 up1 = hn::Set(d1, kWidenUp), down1 = hn::Set(d1, kWidenDown);
-        while (!node->leaf()) {
-            KD_COUNT(nodes, 1);
-            const int a = node->axis();
-            const float split = node->split;
-            const float oa = r.o[a];
-            const int above = int(r.o_above[a] > split);
-            const Node* below = nodes + node->children();
-            // Pushed unless the plane is behind (tp <= 0) or beyond the segment; a NaN tp (the
-            // ray lies in the plane) fails both comparisons and so pushes, over the whole segment:
-            // `x > 0 ? x : 0` (what maxss x, 0 computes) gives 0 for a NaN x. The segment's end
-            // is a running minimum over the planes ahead (min(t1, tp) when tp > 0, which leaves
-            // t1 alone where nothing was pushed, NaN included), so its update does not wait for
-            // the push decision.
-            // The two selects on tp are one-lane vector selects: GCC 12 compiles a scalar
-            // `tp > 0 ? tp * up : inf` to a branch on tp however it is written (the product sinks
-            // into its arm), and that branch mispredicts here (bounce rays 10% slower); without
-            // SSE4.1 it branches on `x > 0 ? x : 0` too. IfThenElse, not Max: Max's result for a
-            // NaN differs between targets (NEON returns the NaN).
-            const float tp = (split - oa) * r.inv_d[a];
-            const V1 vtp = hn::Set(d1, tp), tp_down = hn::Mul(vtp, down1);
-            const float tp_ahead = hn::GetLane(hn::IfThenElse(hn::Gt(vtp, zero1), hn::Mul(vtp, up1), inf1));
-            const int push = int(!(tp <= 0.f)) & int(!(tp > t1 * kWidenUp));
-            st_node[sp] = below + (1 - above);
-            st_t0[sp] = hn::GetLane(hn::IfThenElse(hn::Gt(tp_down, zero1), tp_down, zero1));
-            st_t1[sp] = t1;
-            sp += push & int(node->empty_child(1 - above) ^ 1u);
-            t1 = t1 < tp_ahead ? t1 : tp_ahead;
-            node = below + above;
-        }
+    if (leaf_root) {
+        float t0, t1;
+        if (!leaf_root->intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
+        KD_COUNT(leaves, 1);
+        return test_leaf<Shadow>(r, sh, blocks + nodes[0].child[0], nodes[0].count[0], ray, hit, tmax, found) ||
+               found;
     }
+    struct Entry {
+        uint32_t child, count;
+        float t;
+    };
+    // A step pops one entry and pushes at most eight, and the collapsed tree is no deeper than the
+    // binary one (kMaxDepth): at most 7 kMaxDepth + 8 entries.
+    Entry st[8 * (KdTree::kMaxDepth + 2)];
+    int sp = 0;
+    const DL d;
+    // Per axis, the offsets (in floats from a node's start) of the near and far planes' lanes.
+    int near_off[3], far_off[3];
+    for (int a = 0; a < 3; ++a) {
+        const int lo = a * kLanes, hi = (3 + a) * kLanes;
+        near_off[a] = r.d_neg[a] ? hi : lo;
+        far_off[a] = r.d_neg[a] ? lo : hi;
+    }
+    const VL ox = hn::Set(d, r.o[0]), oy = hn::Set(d, r.o[1]), oz = hn::Set(d, r.o[2]);
+    const VL ix = hn::Set(d, r.inv_d[0]), iy = hn::Set(d, r.inv_d[1]), iz = hn::Set(d, r.inv_d[2]);
+    const VL down = hn::Set(d, kWidenDown), up = hn::Set(d, kWidenUp);
+    const VL tmin = hn::Set(d, std::max(ray.tmin, 0.f));
+    uint32_t cur = 0;
     for (;;) {
         KD_COUNT(nodes, 1);
-        if (!node->leaf()) {
-            const int a = node->axis();
-            const float split = node->split;
-            const float oa = r.o[a];
-            const float tp = (split - oa) * r.inv_d[a];
-            // The sign of split - o is exact, so the child holding the origin is found without
-            // rounding; a ray starting on the plane goes first to the side it moves into.
-            const bool below_first = oa < split || (oa == split && r.d_nonpos[a]);
-            const Node* below = nodes + node->children();
-            const Node* above = below + 1;
-            const Node* first = below_first ? below : above;
-            const Node* second = below_first ? above : below;
-            // tp <= 0: the plane is behind (or the origin is on it, moving away); tp is NaN only
-            // for a ray lying in the plane, which then visits both children over the whole interval
-            // (std::max / std::min return their first argument for a NaN second). Branches, not
-            // selects: they predict well here, and a branch-free step makes every step wait for
-            // its comparisons (docs/accel.md has the measurements).
-            // An empty child is never entered nor stacked: the walk goes on with the other one
-            // (its interval trimmed as if the empty one had been visited), or with the stack.
-            const uint32_t first_empty = node->empty_child(!below_first), second_empty = node->empty_child(below_first);
-            if (tp > t1 * kWidenUp || tp <= 0.f) {
-                node = first;
-                if (!first_empty) continue;
-            } else if (tp < t0 * kWidenDown) {
-                node = second;
-                if (!second_empty) continue;
-            } else if (first_empty) {
-                node = second;
-                t0 = std::max(t0, tp * kWidenDown);
-                if (!second_empty) continue;
-            } else {
-                if (!second_empty) {
-                    st_node[sp] = second;
-                    st_t0[sp] = std::max(t0, tp * kWidenDown);
-                    st_t1[sp++] = t1;
-                }
-                node = first;
-                t1 = std::min(t1, tp * kWidenUp);
-                continue;
-            }
-        } else {
-            const uint32_t count = node->count();
-            KD_COUNT(leaves, 1);
-            KD_COUNT(tris, count);
-            auto record = [&](float t, float b1, float b2, uint32_t prim) {
-                tmax = t;
-                ray.tmax = t;
-                hit->t = t;
-                hit->b1 = b1;
-                hit->b2 = b2;
-                hit->prim = prim;
-                found = true;
-            };
-            const TriBlock* b = blocks + node->first;
-            for (uint32_t i = 0; i < count; i += kLanes, ++b) {
-                const uint32_t n = std::min(count - i, uint32_t(kLanes));
-                unsigned scalar;
-                BlockHits bh;
-                const unsigned hits = triangle_hits(r, *b, ray.tmin, ray.tmax, (1u << n) - 1u, scalar, bh);
-                if (Shadow && hits) return true;
-                // In lane order, as the scalar test would meet them: a later lane replaces an
-                // earlier hit only when strictly closer. Lanes with an edge function exactly 0 go
-                // to the shared scalar test (its double fallback), so every hit is bit-identical
-                // to brute force.
-                for (unsigned m = hits | scalar; m; m &= m - 1) {
-                    const int k = __builtin_ctz(m);
-                    if (scalar >> k & 1u) {
-                        TriangleHit th;
-                        const vec3 p0(b->v[0][0][k], b->v[0][1][k], b->v[0][2][k]);
-                        const vec3 p1(b->v[1][0][k], b->v[1][1][k], b->v[1][2][k]);
-                        const vec3 p2(b->v[2][0][k], b->v[2][1][k], b->v[2][2][k]);
-                        if (!intersect_triangle(ray, sh, p0, p1, p2, th)) continue;
-                        if constexpr (Shadow) return true;
-                        record(th.t, th.b1, th.b2, b->prim[k]);
-                    } else if constexpr (!Shadow) {
-                        if (bh.t[k] < ray.tmax) record(bh.t[k], bh.b1[k], bh.b2[k], b->prim[k]);
+        const float* base = &nodes[cur].lo[0][0];
+        alignas(32) float tn[kLanes];
+        unsigned bits = 0;
+        const VL tmax_v = hn::Set(d, tmax);
+        for (int c = 0; c < kLanes; c += kStep) {
+            VL tnear = tmin, tfar = tmax_v;
+            slab(d, base + near_off[0] + c, base + far_off[0] + c, ox, ix, tnear, tfar);
+            slab(d, base + near_off[1] + c, base + far_off[1] + c, oy, iy, tnear, tfar);
+            slab(d, base + near_off[2] + c, base + far_off[2] + c, oz, iz, tnear, tfar);
+            tnear = hn::Mul(tnear, down);
+            hn::Store(tnear, d, tn + c);
+            bits |= lane_bits(hn::Le(tnear, hn::Mul(tfar, up))) << c;
+        }
+        // The nearest child hit is taken next, the others stacked farthest first.
+        const KdTree::WideNode& n = nodes[cur];
+        Entry next{0, 0, 0.f};
+        bool have = false;
+        if (bits) {
+            have = true;
+            int k = __builtin_ctz(bits);
+            bits &= bits - 1;
+            next = Entry{n.child[k], n.count[k], tn[k]};
+            if (bits) {
+                k = __builtin_ctz(bits);
+                bits &= bits - 1;
+                Entry other{n.child[k], n.count[k], tn[k]};
+                if (!bits) {
+                    // Two: one comparison, written as selects (it mispredicts as a branch).
+                    const bool swap = !Shadow && other.t < next.t;
+                    const Entry near_e = swap ? other : next, far_e = swap ? next : other;
+                    st[sp++] = far_e;
+                    next = near_e;
+                } else {
+                    // More: insertion sort by entry distance (at most eight), stacked in reverse.
+                    Entry e[kLanes];
+                    e[0] = next;
+                    e[1] = other;
+                    int ne = 2;
+                    if (!Shadow && e[1].t < e[0].t) std::swap(e[0], e[1]);
+                    for (; bits; bits &= bits - 1) {
+                        k = __builtin_ctz(bits);
+                        const Entry x{n.child[k], n.count[k], tn[k]};
+                        int j = ne++;
+                        if constexpr (!Shadow) {
+                            for (; j > 0 && e[j - 1].t > x.t; --j) e[j] = e[j - 1];
+                        }
+                        e[j] = x;
                     }
+                    for (int j = ne - 1; j >= 1; --j) st[sp++] = e[j];
+                    next = e[0];
                 }
             }
         }
-        // Next node in ray order, skipping those that start beyond the closest hit (with slack, so
-        // that a hit within rounding of a boundary still meets the triangles beyond it). Entries
-        // are skipped, not the walk ended: a ray lying in a split plane pushes a node whose
-        // interval starts before those pushed after it.
+        // The next interior node; leaves on the way are tested as they come.
         for (;;) {
-            if (sp == 0) return found;
-            --sp;
-            if (Shadow || !(tmax < st_t0[sp] * kWidenDown)) {
-                node = st_node[sp];
-                t0 = st_t0[sp];
-                t1 = st_t1[sp];
+            if (!have) {
+                if (sp == 0) return found;
+                next = st[--sp];
+                if (!Shadow && next.t > tmax * kWidenUp) continue;
+            }
+            have = false;
+            if (next.count == KdTree::kWideInterior) {
+                cur = next.child;
                 break;
             }
+            KD_COUNT(leaves, 1);
+            if (test_leaf<Shadow>(r, sh, blocks + next.child, next.count, ray, hit, tmax, found)) return true;
         }
     }
 }
@@ -381,12 +385,13 @@ bool trace(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB
 }  // namespace
 
 // The entry points of each target, for the dispatch table below.
-bool KdIntersect(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB& bounds, Ray& ray, Hit& hit) {
-    return trace<false>(nodes, blocks, bounds, ray, &hit);
+bool KdIntersect(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const AABB* leaf_root, Ray& ray,
+                 Hit& hit) {
+    return trace<false>(nodes, blocks, leaf_root, ray, &hit);
 }
-bool KdOccluded(const KdTree::Node* nodes, const KdTree::TriBlock* blocks, const AABB& bounds, const Ray& ray) {
+bool KdOccluded(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const AABB* leaf_root, const Ray& ray) {
     Ray r = ray;
-    return trace<true>(nodes, blocks, bounds, r, nullptr);
+    return trace<true>(nodes, blocks, leaf_root, r, nullptr);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -401,12 +406,12 @@ HWY_EXPORT(KdOccluded);
 
 bool KdTree::intersect(Ray& ray, Hit& hit) const {
     if (nodes_.empty()) return false;
-    return HWY_DYNAMIC_DISPATCH(KdIntersect)(nodes_.data(), blocks_.data(), bounds_, ray, hit);
+    return HWY_DYNAMIC_DISPATCH(KdIntersect)(nodes_.data(), blocks_.data(), root_leaf_ ? &bounds_ : nullptr, ray, hit);
 }
 
 bool KdTree::occluded(const Ray& ray) const {
     if (nodes_.empty()) return false;
-    return HWY_DYNAMIC_DISPATCH(KdOccluded)(nodes_.data(), blocks_.data(), bounds_, ray);
+    return HWY_DYNAMIC_DISPATCH(KdOccluded)(nodes_.data(), blocks_.data(), root_leaf_ ? &bounds_ : nullptr, ray);
 }
 
 }  // namespace candela
