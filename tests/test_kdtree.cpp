@@ -4,6 +4,7 @@
 // big meshes, where brute force is slow); plus watertightness: rays
 // aimed exactly at shared edges and vertices of closed and tessellated meshes always hit.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 #include <omp.h>
 #include <cstdio>
 #include <fstream>
@@ -321,6 +322,48 @@ void expect_watertight(const Mesh& m, vec3 origin, const std::vector<vec3>& targ
 }
 
 }  // namespace
+
+// The traversal is compiled once per SIMD target and chosen at run time (kdtree_trace.cpp). Each
+// target this CPU can run is forced in turn (Highway's test hook) and checked against brute force:
+// the 4-lane kernels (SSE4, SSSE3; NEON on aarch64) and the scalar fallback, which this machine's
+// dispatch would never pick, run too. Rays include directions with -0 components (inv_d = -inf:
+// the box test must take the upper plane as the near one), and a mesh that is one leaf (the root
+// box test instead of the node step).
+TEST(KdTree, EverySimdTargetMatchesBruteForce) {
+    const Mesh soup = random_soup(2000, 5);
+    std::vector<Ray> rays = make_rays(soup, 12000, 5);
+    for (size_t i = 0, n = rays.size(); i < n; ++i) {
+        Ray r = rays[i];
+        bool zero = false;
+        for (int a = 0; a < 3; ++a)
+            if (r.d[a] == 0.f) {
+                r.d[a] = -0.f;
+                zero = true;
+            }
+        if (zero) rays.push_back(r);
+    }
+    ASSERT_GT(rays.size(), 14000u) << "the ray set should have axis-parallel and in-plane rays";
+    const Reference ref = brute_force(soup, rays);
+    const Mesh small = random_soup(12, 6);  // one leaf
+    const std::vector<Ray> small_rays = make_rays(small, 3000, 6);
+    const Reference small_ref = brute_force(small, small_rays);
+    struct Restore {
+        ~Restore() { hwy::SetSupportedTargetsForTest(0); }
+    } restore;
+    const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+#if defined(__x86_64__)
+    EXPECT_GE(targets.size(), 3u) << "x86-64: at least SSSE3, SSE4 and the fallback";
+#endif
+    for (int64_t target : targets) {
+        hwy::SetSupportedTargetsForTest(target);
+        const std::string name = hwy::TargetName(target);
+        KdTreeAccel kd(soup);
+        expect_matches(kd, soup, rays, ref, "random soup, forcing target " + name);
+        KdTreeAccel kd_small(small);
+        EXPECT_EQ(kd_small.tree().stats().nodes, 1u) << "the small mesh should be one leaf";
+        expect_matches(kd_small, small, small_rays, small_ref, "one leaf, forcing target " + name);
+    }
+}
 
 TEST(KdTree, RandomSoupMatchesBruteForce) { check_all(random_soup(3000, 1), 50000, 1, "random soup"); }
 
