@@ -9,9 +9,9 @@
 //
 // Layout and traversal (kdtree_trace.cpp): the binary tree is collapsed into nodes of up to eight
 // children, each boxed by what it holds, so that one vector step (8 lanes on AVX2, two of 4 on
-// SSE4 and NEON) tests a node's children and a ray takes a few wide steps where it took some 27
-// binary ones; the SAH build, the leaves and the exact triangle test are the k-d tree's. Empty
-// leaves vanish. Traversal keeps a fixed stack, visits the children hit nearest first and skips
+// SSE4 and NEON) tests all of a node's children and a ray takes a few wide steps instead of one
+// binary step per level; the SAH build, the leaves and the exact triangle test are the k-d
+// tree's. Empty leaves vanish. Traversal keeps a fixed stack, visits the children hit nearest first and skips
 // those beyond the closest hit; a template <bool Shadow> is the any-hit variant. It is compiled
 // per SIMD target (Highway) and chosen at run time. Leaves hold their triangles' vertices in
 // blocks of eight, laid out for the triangle test's lanes (a copy per leaf reference). Every
@@ -46,8 +46,9 @@ struct KdTreeStats {
     int max_depth = 0;
 };
 
-// Traversal counters for tuning, compiled in only with -DCANDELA_KD_COUNTERS (per thread; the
-// benchmark prints them per ray). Without the flag they stay zero and cost nothing.
+// Traversal counters for tuning (`nodes` counts wide nodes), compiled in only with
+// -DCANDELA_KD_COUNTERS (per thread; the benchmark prints them per ray). Without the flag they
+// stay zero and cost nothing.
 struct KdTraceCounters {
     uint64_t rays = 0, nodes = 0, leaves = 0, tris = 0;
 };

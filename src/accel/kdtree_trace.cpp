@@ -338,7 +338,7 @@ bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const 
                 bits &= bits - 1;
                 Entry other{n.child[k], n.count[k], tn[k]};
                 if (!bits) {
-                    // Two: one comparison, written as selects (it mispredicts as a branch).
+                    // Two: one comparison, written as selects.
                     const bool swap = !Shadow && other.t < next.t;
                     const Entry near_e = swap ? other : next, far_e = swap ? next : other;
                     st[sp++] = far_e;
