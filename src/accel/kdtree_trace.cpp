@@ -264,8 +264,18 @@ inline bool test_leaf(const RayData& r, const RayShear& sh, const KdTree::TriBlo
 inline void slab(const DL d, const float* near_plane, const float* far_plane, VL o, VL inv, VL& tnear, VL& tfar) {
     const VL tn = hn::Mul(hn::Sub(hn::Load(d, near_plane), o), inv);
     const VL tf = hn::Mul(hn::Sub(hn::Load(d, far_plane), o), inv);
+#if HWY_TARGET == HWY_AVX2
+    // maxps / minps return their second operand when either is NaN: the same result in one
+    // instruction instead of a compare and a blend.
+    tnear.raw = _mm256_max_ps(tn.raw, tnear.raw);
+    tfar.raw = _mm256_min_ps(tf.raw, tfar.raw);
+#elif HWY_TARGET == HWY_SSE4 || HWY_TARGET == HWY_SSSE3
+    tnear.raw = _mm_max_ps(tn.raw, tnear.raw);
+    tfar.raw = _mm_min_ps(tf.raw, tfar.raw);
+#else
     tnear = hn::IfThenElse(hn::Gt(tn, tnear), tn, tnear);
     tfar = hn::IfThenElse(hn::Lt(tf, tfar), tf, tfar);
+#endif
 }
 
 // Closest hit (any hit with Shadow) in the collapsed tree. A node's eight child boxes are tested
