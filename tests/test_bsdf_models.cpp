@@ -3,6 +3,9 @@
 // incident angles (grazing included, both sides of dielectrics), eval/pdf agreement with sample(),
 // reciprocity, and the white furnace (albedo <= 1; the energy single-scattering GGX loses).
 #include <gtest/gtest.h>
+#include <algorithm>
+#include <cmath>
+#include <complex>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -526,4 +529,38 @@ TEST(BsdfFurnace, CoatTables) {
     EXPECT_TRUE(is_black(r.eval(dir(0.5f), dir(0.6f), TransportMode::Radiance)));
     r.prepare();
     EXPECT_TRUE(r.prepared());
+}
+
+// The conductor's Fresnel reflectance (real arithmetic) against complex Snell's law and the two
+// polarisations evaluated in std::complex<double>, over IORs from silver-like (eta << 1, large k)
+// to dielectric-like (k = 0), grazing to normal incidence.
+TEST(Fresnel, ConductorMatchesComplexArithmetic) {
+    using C = std::complex<double>;
+    double worst = 0.0;
+    for (double eta : {0.05, 0.14, 0.2, 0.5, 1.0, 1.5, 2.5, 4.0, 10.0})
+        for (double k : {0.0, 0.01, 0.5, 1.0, 2.5, 3.6, 5.0, 10.0})
+            for (int i = 0; i <= 66; ++i) {
+                // n = 1 exactly reflects nothing but at grazing incidence, where 1 - cos^2 rounds
+                // to 1 in float below cos = 2.4e-4 (so does every float evaluation): not a conductor.
+                if (eta == 1.0 && k == 0.0) continue;
+                const double c = i == 0 ? 1e-4 : i == 66 ? 1.0 - 1e-6 : (i - 1) / 64.0;
+                const C n(eta, k);
+                const C cos_t = std::sqrt(1.0 - (1.0 - c * c) / (n * n));
+                const C r_perp = (c - n * cos_t) / (c + n * cos_t), r_parl = (n * c - cos_t) / (n * c + cos_t);
+                const double ref = 0.5 * (std::norm(r_perp) + std::norm(r_parl));
+                const float F = fresnel_conductor(float(c), float(eta), float(k));
+                ASSERT_TRUE(std::isfinite(F)) << eta << " " << k << " " << c;
+                worst = std::max(worst, std::abs(double(F) - ref));
+                EXPECT_NEAR(F, ref, 1e-6) << "eta " << eta << " k " << k << " cos " << c;
+            }
+    std::printf("largest |F - complex reference|: %.3g\n", worst);
+    // Normal incidence: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2).
+    EXPECT_NEAR(fresnel_conductor(1.f, 0.2f, 3.6f), (0.64f + 12.96f) / (1.44f + 12.96f), 1e-6f);
+    // A purely imaginary IOR (Mitsuba's "none") and n = 0 reflect everything at every angle.
+    for (float c : {0.f, 0.3f, 1.f}) {
+        EXPECT_FLOAT_EQ(fresnel_conductor(c, 0.f, 1.f), 1.f) << c;
+        EXPECT_FLOAT_EQ(fresnel_conductor(c, 0.f, 0.f), 1.f) << c;
+    }
+    // Grazing incidence reflects everything, n = 1 included (0 / 0 in the textbook form).
+    for (float eta : {0.2f, 1.f, 1.5f}) EXPECT_FLOAT_EQ(fresnel_conductor(0.f, eta, 0.f), 1.f) << eta;
 }

@@ -83,7 +83,7 @@ public:
     // that the SIMD filter loads them as they are (8 lanes, or two halves of 4); a leaf holds
     // ceil(count / 8) blocks, the last triangle repeated to fill the last one.
     static constexpr int kBlockLanes = 8;
-    struct alignas(32) TriBlock {
+    struct alignas(64) TriBlock {
         float v[3][3][kBlockLanes];
         uint32_t prim[kBlockLanes];
     };
@@ -95,7 +95,7 @@ public:
     // step (two of 4) tests them all; an unused lane has an empty box (+inf, -inf), which no ray
     // enters. Node 0 is the root.
     static constexpr uint32_t kWideInterior = 0xffffffffu;
-    struct alignas(32) WideNode {
+    struct alignas(64) WideNode {
         float lo[3][kBlockLanes], hi[3][kBlockLanes];
         uint32_t child[kBlockLanes];  // a WideNode index, or a leaf's first TriBlock
         uint32_t count[kBlockLanes];  // kWideInterior, or the leaf's triangle count (0: unused lane)

@@ -1,7 +1,6 @@
 #pragma once
 // Fresnel equations and the mirror / refraction directions they go with, in the local shading
 // frame (n = +z). Unpolarised light throughout: reflectances are the mean of the s and p ones.
-#include <complex>
 #include <optional>
 #include <string>
 #include "core/math.h"
@@ -58,16 +57,29 @@ inline vec3 refract(vec3 w, vec3 m, float cos_t, float eta_ti) {
 // Reflectance of a conductor with complex IOR eta + i k (relative to the outside medium) for an
 // incident cosine cos_i in [0, 1], per colour channel. With (eta, k) = (0, 1), i.e. a purely
 // imaginary IOR, both polarisations reflect totally: F = 1 at every angle (Mitsuba's "none").
+//
+// Complex Snell's law and the two polarisations written out in real arithmetic (the form of
+// Moeller's "Optics", which Mitsuba 3 and pbrt-v3 also use): with n^2 - sin^2 = a^2 - b^2 + 2iab,
+// a^2 + b^2 = |eta^2 - k^2 - sin^2 + 2i eta k|, then R_s and R_p / R_s as ratios of real terms.
+// The std::complex version it replaces went through libgcc's __divsc3 and csqrtf: 7% of a sample
+// of the rough Cornell box. tests/test_bsdf_models.cpp checks it against complex arithmetic in
+// double.
 inline float fresnel_conductor(float cos_i, float eta, float k) {
-    using C = std::complex<float>;
-    const C n(eta, k);
-    if (std::norm(n) == 0.f) return 1.f;
+    if (eta * eta + k * k == 0.f) return 1.f;
     cos_i = std::clamp(cos_i, 0.f, 1.f);
-    const float sin2_i = 1.f - cos_i * cos_i;
-    const C cos_t = std::sqrt(C(1.f) - C(sin2_i) / (n * n));  // complex Snell's law
-    const C r_perp = (C(cos_i) - n * cos_t) / (C(cos_i) + n * cos_t);
-    const C r_parl = (n * C(cos_i) - cos_t) / (n * C(cos_i) + cos_t);
-    return 0.5f * (std::norm(r_perp) + std::norm(r_parl));
+    const float cos2 = cos_i * cos_i, sin2 = 1.f - cos2;
+    const float re = eta * eta - k * k - sin2;                    // Re(n^2 - sin^2)
+    const float a2b2 = std::sqrt(re * re + 4.f * eta * eta * k * k);  // |n^2 - sin^2| = a^2 + b^2
+    // a^2 = (a^2 + b^2 + re) / 2, or, where re < 0 would cancel it (total internal reflection of
+    // a nearly real eta < 1), the same as 2 eta^2 k^2 / (a^2 + b^2 - re).
+    const float a2 = re >= 0.f ? 0.5f * (a2b2 + re) : 2.f * eta * eta * k * k / (a2b2 - re);
+    const float a = std::sqrt(a2);  // Re(sqrt(n^2 - sin^2))
+    const float t1 = a2b2 + cos2, t2 = 2.f * cos_i * a;
+    if (!(t1 + t2 > 0.f)) return 1.f;  // n^2 = 1 at grazing incidence: the limit, total reflection
+    const float r_s = (t1 - t2) / (t1 + t2);
+    const float t3 = a2b2 * cos2 + sin2 * sin2, t4 = t2 * sin2;
+    const float r_p = r_s * (t3 - t4) / (t3 + t4);
+    return 0.5f * (r_s + r_p);
 }
 inline vec3 fresnel_conductor(float cos_i, vec3 eta, vec3 k) {
     return vec3(fresnel_conductor(cos_i, eta.x, k.x), fresnel_conductor(cos_i, eta.y, k.y),
