@@ -246,6 +246,37 @@ TEST(DiscreteDistribution, ZeroWeightsNeverReturnedAtBoundaries) {
     }
 }
 
+TEST(DiscreteDistribution, BranchlessSearchIsUpperBound) {
+    // sample() searches without branches; its index must be the one std::upper_bound gives on the
+    // normalised cdf (minus one, clamped, then stepped off zero-width bins), for every u tried:
+    // random ones, every cdf step and one float either side, and the ends.
+    for (std::vector<float> w : {kWeights, std::vector<float>{2.f}, std::vector<float>{1.f, 3.f},
+                                 std::vector<float>{1.f, 0.f, 2.f}, std::vector<float>(1000, 1.f)}) {
+        if (w.size() == 1000)
+            for (size_t i = 0; i < w.size(); ++i) w[i] = float((i * 7919) % 13);
+        DiscreteDistribution d(w);
+        std::vector<double> cdf(w.size() + 1, 0.0);
+        for (size_t i = 0; i < w.size(); ++i) cdf[i + 1] = cdf[i] + double(w[i]);
+        std::vector<float> cdf_f(cdf.size());
+        for (size_t i = 0; i < cdf.size(); ++i) cdf_f[i] = float(cdf[i] / cdf.back());
+        cdf_f.back() = 1.f;
+        std::vector<float> us = {0.f, 0x1p-24f, 0.5f, 0x1.fffffep-1f};
+        for (float f : cdf_f)
+            for (float u : {f, next_float_down(f), next_float_up(f)})
+                if (u >= 0.f && u < 1.f) us.push_back(u);
+        PCG32 rng(5u, 9u);
+        for (int k = 0; k < 20000; ++k) us.push_back(rng.next_float());
+        for (float u : us) {
+            auto it = std::upper_bound(cdf_f.begin(), cdf_f.end(), u);
+            size_t want = size_t(std::max<std::ptrdiff_t>(it - cdf_f.begin() - 1, 0));
+            want = std::min(want, w.size() - 1);
+            while (w[want] == 0.f && want > 0) --want;
+            while (w[want] == 0.f && want + 1 < w.size()) ++want;
+            ASSERT_EQ(d.sample(u), want) << "u = " << u << " with " << w.size() << " weights";
+        }
+    }
+}
+
 TEST(DiscreteDistribution, RemappedUIsUniform) {
     // Given the chosen entry, the remapped u must be uniform on [0, 1) and independent of it.
     DiscreteDistribution d(kWeights);

@@ -194,6 +194,82 @@ TEST(Warp, OutputsStayInTheirDomains) {
     }
 }
 
+// The largest error of f against the exact g over [-pi/4, pi/4], in units of the float spacing at
+// the exact value.
+template <class F, class G>
+double max_ulp_error(F f, G g) {
+    double worst = 0;
+    const int n = 1 << 20;
+    for (int i = 0; i <= n; ++i) {
+        const float a = float((double(i) / n * 2.0 - 1.0) * (kPi / 4.0));
+        const double exact = g(double(a));
+        const float e = float(std::abs(exact));
+        const double ulp = double(std::nextafter(e, kInfinity)) - double(e);
+        worst = std::max(worst, std::abs(double(f(a)) - exact) / ulp);
+    }
+    return worst;
+}
+
+TEST(Warp, QuarterSinCosWithinTwoUlp) {
+    // The concentric map's sin and cos (no libm) over the whole range it uses, on 2^20 + 1 angles.
+    const double es = max_ulp_error([](float a) { float s, c; sincos_quarter(a, s, c); return s; },
+                                    [](double a) { return std::sin(a); });
+    const double ec = max_ulp_error([](float a) { float s, c; sincos_quarter(a, s, c); return c; },
+                                    [](double a) { return std::cos(a); });
+    std::printf("  sin within %.2f ulp, cos within %.2f ulp\n", es, ec);
+    EXPECT_LE(es, 2.0);
+    EXPECT_LE(ec, 2.0);
+    // The measure can fail: sin without its last term is off by far more.
+    const double crude = max_ulp_error([](float a) { return a - a * a * a * (1.f / 6.f) + a * a * a * a * a * (1.f / 120.f); },
+                                       [](double a) { return std::sin(a); });
+    EXPECT_GT(crude, 2.0);
+}
+
+TEST(Warp, BranchlessFormsMatchTheBranchingOnes) {
+    // The triangle warp chooses its half without a branch; it must give the branching form's bits.
+    // The concentric map's wedge likewise (its angle then goes to sincos_quarter, tested above).
+    PCG32 rng(3, 7);
+    std::vector<vec2> us = {vec2(0.f), vec2(0.5f), vec2(0.25f), vec2(0.f, 0x1.fffffep-1f), vec2(0x1.fffffep-1f, 0.f)};
+    for (int i = 0; i < 200000; ++i) us.push_back(next_2d(rng));
+    for (vec2 u : us) {
+        float b0, b1;
+        if (u.x < u.y) {
+            b0 = u.x / 2.f;
+            b1 = u.y - b0;
+        } else {
+            b1 = u.y / 2.f;
+            b0 = u.x - b1;
+        }
+        const vec2 b = square_to_uniform_triangle(u);
+        ASSERT_EQ(float_to_bits(b.x), float_to_bits(b0)) << u.x << " " << u.y;
+        ASSERT_EQ(float_to_bits(b.y), float_to_bits(b1)) << u.x << " " << u.y;
+        // The concentric map against its angle written out with libm: the same point to float
+        // rounding (r cos theta, r sin theta).
+        const vec2 o = 2.f * u - vec2(1.f);
+        if (o.x == 0.f && o.y == 0.f) continue;
+        const bool xm = std::abs(o.x) > std::abs(o.y);
+        const double r = xm ? o.x : o.y;
+        const double theta = xm ? kPi / 4.0 * (double(o.y) / o.x) : kPi / 2.0 - kPi / 4.0 * (double(o.x) / o.y);
+        const vec2 d = square_to_uniform_disk_concentric(u);
+        ASSERT_NEAR(d.x, r * std::cos(theta), 4e-7) << u.x << " " << u.y;
+        ASSERT_NEAR(d.y, r * std::sin(theta), 4e-7) << u.x << " " << u.y;
+    }
+}
+
+TEST(Warp, MaxDimensionAndAbs3) {
+    // max_dimension is branchless; the branching form's answer on every order of three values,
+    // with ties, signed zeros and a NaN.
+    const float vals[] = {-2.f, -0.f, 0.f, 1.f, 3.f, std::nanf("")};
+    for (float x : vals)
+        for (float y : vals)
+            for (float z : vals) {
+                const int want = (x > y) ? (x > z ? 0 : 2) : (y > z ? 1 : 2);
+                ASSERT_EQ(max_dimension(vec3(x, y, z)), want) << x << " " << y << " " << z;
+                const vec3 a = abs3(vec3(x, y, z));
+                ASSERT_FALSE(std::signbit(a.x) || std::signbit(a.y) || std::signbit(a.z));
+            }
+}
+
 // ---- the test must be able to fail --------------------------------------------------------------
 
 TEST(Warp, ChiSquareRejectsWrongPdfsAndSamplers) {

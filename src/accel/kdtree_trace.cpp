@@ -112,7 +112,7 @@ inline unsigned lane_bits(ML m) {
 // shear, the edge functions, the determinant, the scaled distance and its interval check, the
 // division, and the error bound on t (the degenerate-triangle check is done once, at build; see
 // below), with the same float operations in the same order (Mul then Add, never MulAdd, and no
-// contraction: see the top of the file; max and abs written to give what std::max and glm::abs
+// contraction: see the top of the file; max and abs written to give what std::max and abs3
 // give), so each lane's result is the scalar test's, bit for bit. Lanes with an edge function
 // exactly 0 are left to the scalar test itself (it redoes them in double): they come back in
 // `scalar`. The hits come back in the return value, with t, b1 and b2 in `out` (indexed by block

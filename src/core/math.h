@@ -29,7 +29,18 @@ constexpr float gamma_bound(int n) { return (n * kMachineEpsilon) / (1 - n * kMa
 
 inline float max_component(vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
 inline float min_component(vec3 v) { return std::min(v.x, std::min(v.y, v.z)); }
-inline int max_dimension(vec3 v) { return (v.x > v.y) ? (v.x > v.z ? 0 : 2) : (v.y > v.z ? 1 : 2); }
+// The axis of the largest component: (x > y) ? (x > z ? 0 : 2) : (y > z ? 1 : 2), without branches
+// (a ray's main axis is a coin toss from one ray to the next).
+inline int max_dimension(vec3 v) {
+    const bool xy = v.x > v.y;
+    const float m = xy ? v.x : v.y;
+    const int i = 1 - int(xy);
+    return 2 - int(m > v.z) * (2 - i);
+}
+// |v| per component with the sign bit cleared (andps). glm::abs is x >= 0 ? x : -x, which GCC
+// compiles to a branch per component, taken at random for directions and normals; the two
+// differ only in the sign of a zero (glm keeps -0), which no comparison sees.
+inline vec3 abs3(vec3 v) { return vec3(std::abs(v.x), std::abs(v.y), std::abs(v.z)); }
 inline float luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 inline bool is_black(vec3 c) { return c.x == 0.f && c.y == 0.f && c.z == 0.f; }
 inline bool all_finite(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -53,6 +64,13 @@ inline float next_float_down(float v) {
     uint32_t ui = float_to_bits(v);
     ui = (v > 0) ? ui - 1 : ui + 1;
     return bits_to_float(ui);
+}
+
+// c ? a : b without a branch, bit for bit the ternary's result. For choices made by random numbers
+// (which of two warps' halves, which side of a split), where a predictor guesses wrong half the time.
+inline float choose(bool c, float a, float b) {
+    const uint32_t m = 0u - uint32_t(c);
+    return bits_to_float((float_to_bits(a) & m) | (float_to_bits(b) & ~m));
 }
 
 // 64-bit mixing (the MurmurHash3 finaliser): turns structured integers into seeds.

@@ -14,7 +14,7 @@ using glm::dvec2;
 // Error bound of a point refined onto a sphere of centre c: q = p - c is the double-precision
 // reprojection rounded to float (<= 1 ulp of |q| per axis), p = c + q one more rounding. pbrt-v4
 // uses gamma(5) |q| for its float reprojection; the extra gamma(2) |p| covers the centre's offset.
-vec3 sphere_point_error(vec3 q, vec3 p) { return gamma_bound(5) * glm::abs(q) + gamma_bound(2) * glm::abs(p); }
+vec3 sphere_point_error(vec3 q, vec3 p) { return gamma_bound(5) * abs3(q) + gamma_bound(2) * abs3(p); }
 
 // Columns of the linear part of m.
 void columns(const mat4& m, vec3& a, vec3& b, vec3& c) {
@@ -256,7 +256,7 @@ AABB AnalyticShape::bounds() const {
         case PrimKind::Triangle: break;
     }
     // Rounding of the corners must not cut off the surface.
-    vec3 pad = gamma_bound(3) * glm::max(glm::abs(box.min), glm::abs(box.max));
+    vec3 pad = gamma_bound(3) * glm::max(abs3(box.min), abs3(box.max));
     return AABB(box.min - pad, box.max + pad);
 }
 
@@ -424,7 +424,7 @@ SurfaceInteraction analytic_interaction(const AnalyticShape& s, const Hit& hit) 
         }
         case PrimKind::Cylinder: {
             // pbrt-v4 Cylinder: gamma(3) |(x, y, 0)| for the radial reprojection in object space.
-            vec3 pe = gamma_bound(3) * glm::abs(vec3(q.x, q.y, 0.f));
+            vec3 pe = gamma_bound(3) * abs3(vec3(q.x, q.y, 0.f));
             si.p = transform_point_error(s.to_world, q, pe, &si.p_error);
             si.ng = si.ns = cylinder_normal(s, q);
             si.uv = vec2(float(wrap_phi(q.y, q.x) / (2.0 * 3.14159265358979323846)), q.z / s.length);
@@ -506,7 +506,7 @@ bool sample_analytic(const AnalyticShape& s, vec3 ref_p, vec2 u, AnalyticSample&
         case PrimKind::Cylinder: {
             float phi = 2.f * kPi * u.y;
             vec3 q(s.radius * std::cos(phi), s.radius * std::sin(phi), u.x * s.length);
-            out.p = transform_point_error(s.to_world, q, gamma_bound(3) * glm::abs(vec3(q.x, q.y, 0.f)), &out.p_error);
+            out.p = transform_point_error(s.to_world, q, gamma_bound(3) * abs3(vec3(q.x, q.y, 0.f)), &out.p_error);
             out.n = cylinder_normal(s, q);
             break;
         }

@@ -38,7 +38,7 @@ inline AABB transform_box(const mat4& m, const AABB& box) {
         vec3 p((c & 1) ? box.max.x : box.min.x, (c & 2) ? box.max.y : box.min.y, (c & 4) ? box.max.z : box.min.z);
         out.expand(vec3(m * glm::vec4(p, 1.f)));
     }
-    vec3 pad = gamma_bound(8) * glm::max(glm::abs(out.min), glm::abs(out.max));
+    vec3 pad = gamma_bound(8) * glm::max(abs3(out.min), abs3(out.max));
     return AABB(out.min - pad, out.max + pad);
 }
 

@@ -44,7 +44,7 @@ struct SurfaceInteraction {
 // the surface (pbrt-v4 OffsetRayOrigin). The offset scales with the coordinates themselves, so it
 // works at any scene scale, unlike a fixed epsilon.
 inline vec3 offset_ray_origin(vec3 p, vec3 p_error, vec3 n, vec3 w) {
-    float d = glm::dot(glm::abs(n), p_error);
+    float d = glm::dot(abs3(n), p_error);
     vec3 offset = d * n;
     if (glm::dot(w, n) < 0.f) offset = -offset;
     vec3 po = p + offset;

@@ -13,7 +13,7 @@ struct RayShear {
     int kx, ky, kz;
     float sx, sy, sz;
     explicit RayShear(vec3 d) {
-        kz = max_dimension(glm::abs(d));
+        kz = max_dimension(abs3(d));
         kx = kz + 1 == 3 ? 0 : kz + 1;
         ky = kx + 1 == 3 ? 0 : kx + 1;
         sx = -d[kx] / d[kz];
@@ -72,14 +72,14 @@ inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3
     // "Physically Based Rendering", 4th ed.). A ray leaving a surface point whose coordinate along
     // the normal is exact (e.g. a wall at x = 0: zero error, so zero origin offset) would otherwise
     // re-hit its own triangle at t ~ 1e-8 from rounding in the other coordinates.
-    float max_zt = max_component(glm::abs(vec3(az, bz, cz)));
-    float max_xt = max_component(glm::abs(vec3(ax, bx, cx)));
-    float max_yt = max_component(glm::abs(vec3(ay, by, cy)));
+    float max_zt = max_component(abs3(vec3(az, bz, cz)));
+    float max_xt = max_component(abs3(vec3(ax, bx, cx)));
+    float max_yt = max_component(abs3(vec3(ay, by, cy)));
     float delta_z = gamma_bound(3) * max_zt;
     float delta_x = gamma_bound(5) * (max_xt + max_zt);
     float delta_y = gamma_bound(5) * (max_yt + max_zt);
     float delta_e = 2.f * (gamma_bound(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    float max_e = max_component(glm::abs(vec3(e0, e1, e2)));
+    float max_e = max_component(abs3(vec3(e0, e1, e2)));
     float delta_t = 3.f * (gamma_bound(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * std::abs(inv_det);
     if (t <= delta_t) return false;
 

@@ -133,7 +133,7 @@ void LightSet::build(const Mesh& mesh, const std::vector<Shape>& shapes, const s
 // Exact point and its error bound from barycentrics (pbrt-v4 uses gamma(6) for this sum).
 static inline void interpolate_point(vec3 p0, vec3 p1, vec3 p2, float b0, float b1, float b2, vec3& p, vec3& err) {
     p = b0 * p0 + b1 * p1 + b2 * p2;
-    err = gamma_bound(6) * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2));
+    err = gamma_bound(6) * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
 }
 
 bool LightSet::sample_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) const {

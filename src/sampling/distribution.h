@@ -32,9 +32,16 @@ public:
 
     // Index i with cdf[i] <= u < cdf[i+1]; entries of zero weight are never returned.
     size_t sample(float u, float* pmf_out = nullptr, float* u_remapped = nullptr) const {
-        auto it = std::upper_bound(cdf_f_.begin(), cdf_f_.end(), u);
-        size_t i = size_t(std::max<std::ptrdiff_t>(it - cdf_f_.begin() - 1, 0));
-        i = std::min(i, pmf_.size() - 1);
+        // upper_bound - 1 (clamped to 0) as a branchless binary search: the last entry that u is
+        // not below (cdf_f_[0] = 0 is never compared). Its steps depend on u, which a branch
+        // predictor cannot follow.
+        const float* base = cdf_f_.data();
+        for (size_t n = cdf_f_.size(); n > 1;) {
+            const size_t half = n / 2;
+            base = u < base[half] ? base : base + half;
+            n -= half;
+        }
+        size_t i = std::min(size_t(base - cdf_f_.data()), pmf_.size() - 1);
         while (pmf_[i] == 0.f && i > 0) --i;  // u landed on a zero-width bin: step back
         while (pmf_[i] == 0.f && i + 1 < pmf_.size()) ++i;
         if (pmf_out) *pmf_out = pmf_[i];

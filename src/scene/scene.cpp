@@ -246,7 +246,7 @@ SurfaceInteraction triangle_interaction(const Mesh& mesh, const std::vector<Shap
     vec3 p0 = mesh.positions[t.x], p1 = mesh.positions[t.y], p2 = mesh.positions[t.z];
     float b0 = 1.f - hit.b1 - hit.b2;
     si.p = b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
-    si.p_error = gamma_bound(7) * (glm::abs(b0 * p0) + glm::abs(hit.b1 * p1) + glm::abs(hit.b2 * p2));
+    si.p_error = gamma_bound(7) * (abs3(b0 * p0) + abs3(hit.b1 * p1) + abs3(hit.b2 * p2));
     si.ng = mesh.face_normals.empty() ? face_normal(p0, p1, p2) : mesh.face_normals[hit.prim];
     si.ns = si.ng;
     if (shapes[si.shape].smooth) {
