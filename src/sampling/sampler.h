@@ -28,8 +28,10 @@ public:
         rng_.set_sequence(hash_combine(px, seed_), mix_bits(seed_ ^ 0x5bd1e995ULL));
         rng_.advance(uint64_t(sample_index) << 16);
     }
-    float next_1d() override { return rng_.next_float(); }
-    vec2 next_2d() override {
+    // Forced inline: the full build's path loop otherwise calls next_2d out of line (GCC's
+    // inlining budget is shared with every other instantiation), the diffuse-only build does not.
+    __attribute__((always_inline)) float next_1d() override { return rng_.next_float(); }
+    __attribute__((always_inline)) vec2 next_2d() override {
         float a = rng_.next_float();
         return vec2(a, rng_.next_float());
     }
