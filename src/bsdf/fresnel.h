@@ -61,8 +61,8 @@ inline vec3 refract(vec3 w, vec3 m, float cos_t, float eta_ti) {
 // Complex Snell's law and the two polarisations written out in real arithmetic (the form of
 // Moeller's "Optics", which Mitsuba 3 and pbrt-v3 also use): with n^2 - sin^2 = a^2 - b^2 + 2iab,
 // a^2 + b^2 = |eta^2 - k^2 - sin^2 + 2i eta k|, then R_s and R_p / R_s as ratios of real terms.
-// The std::complex version it replaces went through libgcc's __divsc3 and csqrtf: 7% of a sample
-// of the rough Cornell box. tests/test_bsdf_models.cpp checks it against complex arithmetic in
+// Real arithmetic because std::complex<float> goes through libgcc's __divsc3 and csqrtf (the cost
+// is in bench/RESULTS.md). tests/test_bsdf_models.cpp checks it against complex arithmetic in
 // double.
 inline float fresnel_conductor(float cos_i, float eta, float k) {
     if (eta * eta + k * k == 0.f) return 1.f;

@@ -8,8 +8,8 @@ namespace candela {
 
 // sin a and cos a for |a| <= pi/4, the only range the concentric map needs, as short polynomials
 // (minimax, the coefficients of Cephes' sinf/cosf; error within 2 ulp of the exact values, tested
-// in test_warp.cpp). No range reduction and no libm call: libm's sincosf was 3-4% of a diffuse
-// sample.
+// in test_warp.cpp). No range reduction and no libm call, which the full-range sincosf needs
+// (the cost is in bench/RESULTS.md).
 inline void sincos_quarter(float a, float& s, float& c) {
     const float a2 = a * a;
     s = a + a * a2 * (-1.6666654611e-1f + a2 * (8.3321608736e-3f + a2 * -1.9515295891e-4f));
