@@ -7,6 +7,7 @@
 // against Mitsuba 3.9.1.
 #include <gtest/gtest.h>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include "bsdf/wrappers.h"
 #include "film/film.h"
@@ -373,4 +374,89 @@ TEST(BsdfWrappers, MitsubaAgreementDetectsWrongBumpScale) {
     double p = whole_image_p(test, ref, nullptr);
     std::printf("  bump scale halved: blocks %s, whole image p = %.3g\n", r.describe().c_str(), p);
     EXPECT_TRUE(!r.passed(kAlpha) || p < kAlpha);
+}
+
+// eval_pdf is what next-event estimation calls in place of eval then pdf: it must give exactly their
+// bits (the images stay the same), for every BSDF of the closed set, both sides, both transport
+// modes, grazing and random directions, and through the wrappers (blends, perturbed frames).
+namespace {
+bool same_bits(const BsdfEval& e, vec3 f, float p) {
+    return std::memcmp(&e.f, &f, sizeof f) == 0 && std::memcmp(&e.pdf, &p, sizeof p) == 0;
+}
+vec3 random_direction(PCG32& rng) {
+    const float z = 1.f - 2.f * rng.next_float(), phi = 2.f * kPi * rng.next_float();
+    const float r = std::sqrt(std::max(0.f, 1.f - z * z));
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+}  // namespace
+
+TEST(BsdfEvalPdf, SameBitsAsEvalAndPdf) {
+    std::vector<std::pair<std::string, Bsdf>> set;
+    set.push_back({"diffuse", diffuse(vec3(0.2f, 0.5f, 0.9f))});
+    set.push_back({"mirror", ConductorBsdf{}});
+    for (float a : {1e-4f, 0.05f, 0.3f, 1.f}) {
+        set.push_back({"rough metal " + std::to_string(a), rough_metal(a)});
+        ConductorBsdf beck;
+        beck.alpha_u = a;
+        beck.alpha_v = 0.5f * a;
+        set.push_back({"anisotropic Beckmann metal " + std::to_string(a), beck});
+        set.push_back({"rough glass " + std::to_string(a), rough_glass(a)});
+        PlasticBsdf pl;
+        pl.alpha = a;
+        pl.distribution = MicrofacetType::GGX;
+        pl.nonlinear = a > 0.2f;
+        pl.prepare();
+        set.push_back({"rough plastic " + std::to_string(a), pl});
+        PPlasticBsdf pp;
+        pp.alpha_u = a;
+        pp.alpha_v = 2.f * a;
+        set.push_back({"pplastic " + std::to_string(a), pp});
+    }
+    PlasticBsdf smooth_plastic;
+    smooth_plastic.prepare();
+    set.push_back({"smooth plastic", smooth_plastic});
+    set.push_back({"unprepared plastic", PlasticBsdf{}});
+    set.push_back({"smooth glass", DielectricBsdf{}});
+    set.push_back({"thin glass", ThinDielectricBsdf{}});
+    PrincipledBsdf pr;
+    pr.metallic = 0.3f;
+    pr.spec_trans = 0.4f;
+    pr.has_spec_trans = true;
+    pr.clearcoat = 0.5f;
+    pr.sheen = 0.6f;
+    pr.anisotropic = 0.5f;
+    set.push_back({"principled", pr});
+    set.push_back({"principled default", PrincipledBsdf{}});
+
+    PCG32 rng(11, 3);
+    for (const auto& [name, b] : set) {
+        int nonzero = 0;
+        for (int i = 0; i < 4000; ++i) {
+            vec3 wo = random_direction(rng), wi = random_direction(rng);
+            if (i % 4 == 0) wo = glm::normalize(vec3(wo.x, wo.y, 1e-4f * wo.z));  // grazing
+            if (i % 8 == 1) wi = glm::normalize(vec3(-wo.x, -wo.y, wo.z) + 1e-3f * wi);  // near the mirror
+            for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+                const BsdfEval e = eval_pdf(b, wo, wi, mode);
+                ASSERT_TRUE(same_bits(e, eval(b, wo, wi, mode), pdf(b, wo, wi, mode)))
+                    << name << " wo " << wo.x << " " << wo.y << " " << wo.z << " wi " << wi.x << " " << wi.y << " " << wi.z;
+                nonzero += e.pdf > 0.f;
+            }
+        }
+        // Every non-delta BSDF is evaluated somewhere (so that the comparison is not of zeros; at
+        // alpha 1e-4 only the near-mirror pairs are).
+        if (has_smooth_component(b) && name != "unprepared plastic") {
+            EXPECT_GT(nonzero, 200) << name;
+        }
+    }
+    for (const BlendCase& c : blend_cases()) {
+        const WrappedBsdf w = wrapped_of(c);
+        int nonzero = 0;
+        for (int i = 0; i < 4000; ++i) {
+            const vec3 wi = random_direction(rng);
+            const BsdfEval e = w.eval_pdf_w(c.wo, wi);
+            ASSERT_TRUE(same_bits(e, w.eval_w(c.wo, wi), w.pdf_w(c.wo, wi))) << c.name;
+            nonzero += e.pdf > 0.f;
+        }
+        EXPECT_GT(nonzero, 1000) << c.name;
+    }
 }

@@ -6,6 +6,7 @@
 //   wi      direction towards the next vertex (the light side, in Radiance mode)
 //   eval    f(wo, wi) * |cos theta_i|            [1/sr], zero for delta lobes
 //   pdf     density of sample() choosing wi       [1/sr, solid angle], zero for delta lobes
+//   eval_pdf  {eval, pdf}, bit for bit the same values, from one evaluation (next-event estimation)
 //   sample  wi with weight = f * |cos theta_i| / pdf; for a delta lobe pdf is the discrete
 //           probability of that lobe and f carries the Dirac's weight, so only f / pdf matters.
 // TransportMode says which quantity flows along the path: Radiance (camera paths) or Importance
@@ -52,6 +53,10 @@ inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode) {
     const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
     return d ? d->pdf(wo, wi, mode) : 0.f;
 }
+inline BsdfEval eval_pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode) {
+    const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
+    return d ? d->eval_pdf(wo, wi, mode) : BsdfEval{};
+}
 inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2, TransportMode mode) {
     const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&b);
     return d ? d->sample(wo, u1, u2, mode) : std::nullopt;
@@ -66,6 +71,9 @@ inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = Transport
 inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     return diffuse_only::pdf(b, wo, wi, mode);
 }
+inline BsdfEval eval_pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    return diffuse_only::eval_pdf(b, wo, wi, mode);
+}
 inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2,
                                         TransportMode mode = TransportMode::Radiance) {
     return diffuse_only::sample(b, wo, u1, u2, mode);
@@ -77,6 +85,10 @@ inline vec3 eval(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = Transport
 }
 inline float pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     return std::visit([&](const auto& x) { return x.pdf(wo, wi, mode); }, b);
+}
+// {eval, pdf} bit for bit, in one call.
+inline BsdfEval eval_pdf(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    return std::visit([&](const auto& x) { return x.eval_pdf(wo, wi, mode); }, b);
 }
 inline std::optional<BsdfSample> sample(const Bsdf& b, vec3 wo, float u1, vec2 u2,
                                         TransportMode mode = TransportMode::Radiance) {
@@ -100,6 +112,11 @@ template <bool DiffuseOnly>
 inline float pdf_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
     if constexpr (DiffuseOnly) return diffuse_only::pdf(b, wo, wi, mode);
     else return pdf(b, wo, wi, mode);
+}
+template <bool DiffuseOnly>
+inline BsdfEval eval_pdf_in(const Bsdf& b, vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) {
+    if constexpr (DiffuseOnly) return diffuse_only::eval_pdf(b, wo, wi, mode);
+    else return eval_pdf(b, wo, wi, mode);
 }
 template <bool DiffuseOnly>
 inline std::optional<BsdfSample> sample_in(const Bsdf& b, vec3 wo, float u1, vec2 u2,

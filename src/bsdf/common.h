@@ -5,6 +5,14 @@ namespace candela {
 
 enum class TransportMode { Radiance, Importance };
 
+// eval() and pdf() of one direction pair, from one evaluation: f |cos theta_i| and the solid-angle
+// density of sample(). Next-event estimation needs both (the pdf for MIS), and the microfacet
+// lobes share their half vector, D and G1 between them, as Mitsuba 3's eval_pdf does.
+struct BsdfEval {
+    vec3 f{0.f};
+    float pdf = 0.f;
+};
+
 struct BsdfSample {
     vec3 f{0.f};       // f * |cos theta_i| (see bsdf.h for delta lobes)
     vec3 wi{0.f};      // sampled direction, local frame

@@ -30,11 +30,15 @@ struct ConductorBsdf {
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode) const {
         if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return vec3(0.f);
-        return eval_pdf(wo, wi).first;
+        return rough(wo, wi).f;
     }
     float pdf(vec3 wo, vec3 wi, TransportMode) const {
         if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return 0.f;
-        return eval_pdf(wo, wi).second;
+        return rough(wo, wi).pdf;
+    }
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode) const {
+        if (is_delta() || wo.z <= 0.f || wi.z <= 0.f) return {};
+        return rough(wo, wi);
     }
     std::optional<BsdfSample> sample(vec3 wo, float, vec2 u, TransportMode) const {
         if (wo.z <= 0.f) return std::nullopt;
@@ -49,22 +53,22 @@ struct ConductorBsdf {
         const vec3 m = microfacet().sample_visible(wo, u);
         s.wi = reflect(wo, m);
         if (s.wi.z <= 0.f) return std::nullopt;  // reflected below the surface: no sample
-        auto [f, p] = eval_pdf(wo, s.wi);
-        if (!(p > 0.f)) return std::nullopt;
-        s.f = f;
-        s.pdf = p;
+        const BsdfEval e = rough(wo, s.wi);
+        if (!(e.pdf > 0.f)) return std::nullopt;
+        s.f = e.f;
+        s.pdf = e.pdf;
         return s;
     }
     bool has_smooth_component() const { return !is_delta(); }
 
 private:
     // Both from the same half vector, so that f / pdf is exactly R F G1(wi, h).
-    std::pair<vec3, float> eval_pdf(vec3 wo, vec3 wi) const {
+    BsdfEval rough(vec3 wo, vec3 wi) const {
         const vec3 h = glm::normalize(wo + wi);
         const Microfacet ggx = microfacet();
         const float D = ggx.D(h);
         const float g1o = ggx.G1(wo, h), g1i = ggx.G1(wi, h);
-        if (D == 0.f || g1o == 0.f || g1i == 0.f) return {vec3(0.f), 0.f};
+        if (D == 0.f || g1o == 0.f || g1i == 0.f) return {};
         const float c = D * g1o / (4.f * wo.z);
         const vec3 F = fresnel_conductor(glm::dot(wo, h), eta, k);
         return {specular_reflectance * F * (c * g1i), c};

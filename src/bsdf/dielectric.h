@@ -47,11 +47,15 @@ struct DielectricBsdf {
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode mode) const {
         if (is_delta()) return vec3(0.f);
-        return eval_pdf(wo, wi, mode).f;
+        return rough(wo, wi, mode).f;
     }
     float pdf(vec3 wo, vec3 wi, TransportMode mode) const {
         if (is_delta()) return 0.f;
-        return eval_pdf(wo, wi, mode).pdf;
+        return rough(wo, wi, mode).pdf;
+    }
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode mode) const {
+        if (is_delta()) return {};
+        return rough(wo, wi, mode);
     }
 
     std::optional<BsdfSample> sample(vec3 wo, float u1, vec2 u2, TransportMode mode) const {
@@ -75,14 +79,14 @@ struct DielectricBsdf {
             return s.pdf > 0.f ? std::optional<BsdfSample>(s) : std::nullopt;
         }
         // m from the normals visible from wo; from inside (wo.z < 0) from those visible from the
-        // mirrored wo, as Mitsuba 3 does, so that m is on the upper side like eval_pdf's h.
+        // mirrored wo, as Mitsuba 3 does, so that m is on the upper side like rough()'s h.
         const Microfacet ggx = microfacet();
         const float side = wo.z > 0.f ? 1.f : -1.f;
         const vec3 m = ggx.sample_visible(wo * side, u2);
         const float om = glm::dot(wo, m);
         const FresnelDielectric fr = fresnel_dielectric(om, e);
         const float dm = ggx.pdf_visible(wo * side, m);  // D_wo(m)
-        // f and pdf come from m itself, not from the half vector eval_pdf rebuilds out of wo and wi:
+        // f and pdf come from m itself, not from the half vector rough() rebuilds out of wo and wi:
         // near grazing reflection wo + wi nearly cancels, and the rebuilt h (so D, G1 and the
         // Jacobian) can be far off m, giving weights of 1e4 and more at alpha 1e-4. From m the
         // weight is exactly R G1(wi, m), or T G1(wi, m) / eta_r^2 in Radiance mode.
@@ -107,13 +111,9 @@ struct DielectricBsdf {
     bool has_smooth_component() const { return !is_delta(); }
 
 private:
-    struct Rough {
-        vec3 f{0.f};
-        float pdf = 0.f;
-    };
     // f |cos theta_i| and the pdf of sample(), from one generalised half vector.
-    Rough eval_pdf(vec3 wo, vec3 wi, TransportMode mode) const {
-        Rough r;
+    BsdfEval rough(vec3 wo, vec3 wi, TransportMode mode) const {
+        BsdfEval r;
         const float co = wo.z, ci = wi.z;
         if (co == 0.f || ci == 0.f) return r;
         const bool reflection = co * ci > 0.f;
@@ -146,7 +146,7 @@ private:
             r.f = specular_transmittance * (v * scale);
             r.pdf = (1.f - F) * dv * eta_r * eta_r * std::abs(ih) / denom2;
         }
-        if (!std::isfinite(r.pdf) || !all_finite(r.f)) return Rough{};
+        if (!std::isfinite(r.pdf) || !all_finite(r.f)) return BsdfEval{};
         return r;
     }
 };

@@ -19,6 +19,10 @@ struct DiffuseBsdf {
         if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
         return square_to_cosine_hemisphere_pdf(wi);
     }
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode) const {
+        if (wo.z <= 0.f || wi.z <= 0.f) return {};
+        return {albedo * (kInvPi * wi.z), square_to_cosine_hemisphere_pdf(wi)};
+    }
     std::optional<BsdfSample> sample(vec3 wo, float, vec2 u, TransportMode) const {
         if (wo.z <= 0.f) return std::nullopt;
         BsdfSample s;

@@ -187,6 +187,19 @@ float PlasticBsdf::pdf(vec3 wo, vec3 wi, TransportMode) const {
     return p;
 }
 
+BsdfEval PlasticBsdf::eval_pdf(vec3 wo, vec3 wi, TransportMode) const {
+    if (wo.z <= 0.f || wi.z <= 0.f || !prepared()) return {};
+    BsdfEval e{diffuse_value(wo, wi), 0.f};
+    const float ps = specular_probability(wo.z);
+    e.pdf = (1.f - ps) * square_to_cosine_hemisphere_pdf(wi);
+    if (!smooth()) {
+        const Lobe c = coat(wo, wi, glm::normalize(wo + wi));
+        e.f += c.f;
+        e.pdf += ps * c.pdf;
+    }
+    return e;
+}
+
 std::optional<BsdfSample> PlasticBsdf::sample(vec3 wo, float u1, vec2 u2, TransportMode mode) const {
     if (wo.z <= 0.f || !prepared()) return std::nullopt;
     const float ps = specular_probability(wo.z);

@@ -61,6 +61,7 @@ struct PlasticBsdf {
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode) const;
     float pdf(vec3 wo, vec3 wi, TransportMode) const;
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode) const;  // the coat evaluated once
     std::optional<BsdfSample> sample(vec3 wo, float u1, vec2 u2, TransportMode) const;
     bool has_smooth_component() const { return true; }
 

@@ -38,12 +38,16 @@ struct PPlasticBsdf {
 
     vec3 eval(vec3 wo, vec3 wi, TransportMode) const {
         if (wo.z <= 0.f || wi.z <= 0.f) return vec3(0.f);
-        return eval_pdf(wo, wi).first;
+        return both(wo, wi).f;
     }
 
     float pdf(vec3 wo, vec3 wi, TransportMode) const {
         if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
-        return eval_pdf(wo, wi).second;
+        return both(wo, wi).pdf;
+    }
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode) const {
+        if (wo.z <= 0.f || wi.z <= 0.f) return {};
+        return both(wo, wi);
     }
 
     std::optional<BsdfSample> sample(vec3 wo, float u1, vec2 u2, TransportMode) const {
@@ -52,17 +56,17 @@ struct PPlasticBsdf {
         s.wi = u1 < specular_probability() ? reflect(wo, microfacet().sample_visible(wo, u2))
                                            : square_to_cosine_hemisphere(u2);
         if (s.wi.z <= 0.f) return std::nullopt;  // reflected below the surface
-        const auto [f, p] = eval_pdf(wo, s.wi);
-        if (!(p > 0.f)) return std::nullopt;
-        s.f = f;
-        s.pdf = p;
+        const BsdfEval e = both(wo, s.wi);
+        if (!(e.pdf > 0.f)) return std::nullopt;
+        s.f = e.f;
+        s.pdf = e.pdf;
         return s;
     }
     bool has_smooth_component() const { return true; }
 
 private:
     // f cos theta_i and the mixture pdf from one half vector and one D(m) (wo.z, wi.z > 0).
-    std::pair<vec3, float> eval_pdf(vec3 wo, vec3 wi) const {
+    BsdfEval both(vec3 wo, vec3 wi) const {
         const float e = eta();
         const vec3 m = glm::normalize(wo + wi);
         const Microfacet mf = microfacet();

@@ -125,6 +125,9 @@ struct PrincipledBsdf {
         return all_finite(value) ? value : vec3(0.f);
     }
 
+    // The two share little (eval's lobes are not the sampling mixture's), so they stay apart.
+    BsdfEval eval_pdf(vec3 wo, vec3 wi, TransportMode mode) const { return {eval(wo, wi, mode), pdf(wo, wi, mode)}; }
+
     float pdf(vec3 wo, vec3 wi, TransportMode) const {
         const float co = wo.z, ci = wi.z;
         if (co == 0.f) return 0.f;

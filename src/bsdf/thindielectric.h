@@ -31,6 +31,7 @@ struct ThinDielectricBsdf {
 
     vec3 eval(vec3, vec3, TransportMode) const { return vec3(0.f); }
     float pdf(vec3, vec3, TransportMode) const { return 0.f; }
+    BsdfEval eval_pdf(vec3, vec3, TransportMode) const { return {}; }
     std::optional<BsdfSample> sample(vec3 wo, float u1, vec2, TransportMode) const {
         if (wo.z == 0.f) return std::nullopt;
         const float r = reflectance(wo.z);

@@ -46,6 +46,15 @@ struct WrappedBsdf {
         for (int k = 0; k < n; ++k) p += w[k] * pdf(*leaf[k], wo, wi, mode);
         return p;
     }
+    BsdfEval mix_eval_pdf(vec3 wo, vec3 wi, TransportMode mode) const {
+        BsdfEval e;
+        for (int k = 0; k < n; ++k) {
+            const BsdfEval l = eval_pdf(*leaf[k], wo, wi, mode);
+            e.f += w[k] * l.f;
+            e.pdf += w[k] * l.pdf;
+        }
+        return e;
+    }
     std::optional<BsdfSample> mix_sample(vec3 wo, float u1, vec2 u2, TransportMode mode) const {
         if (n == 1) return sample(*leaf[0], wo, u1, u2, mode);
         int k = 0;
@@ -82,6 +91,14 @@ struct WrappedBsdf {
         const vec3 wip = frame.to_local(wi);
         if (!(wi.z * wip.z > 0.f)) return 0.f;
         return mix_pdf(frame.to_local(wo), wip, mode);
+    }
+    BsdfEval eval_pdf_w(vec3 wo, vec3 wi, TransportMode mode = TransportMode::Radiance) const {
+        if (!perturbed) return mix_eval_pdf(wo, wi, mode);
+        const vec3 wip = frame.to_local(wi);
+        if (!(wi.z * wip.z > 0.f)) return {};
+        BsdfEval e = mix_eval_pdf(frame.to_local(wo), wip, mode);
+        if (terminator) e.f = e.f * terminator_factor(frame.n, wi);
+        return e;
     }
     std::optional<BsdfSample> sample_w(vec3 wo, float u1, vec2 u2, TransportMode mode = TransportMode::Radiance) const {
         if (!perturbed) return mix_sample(wo, u1, u2, mode);

@@ -40,6 +40,12 @@ struct ShadingT {
             if (is_wrapped) return wrapped.pdf_w(wo, wi, mode);
         return pdf_in<DiffuseOnly>(*bsdf, wo, wi, mode);
     }
+    // {eval(wi), pdf(wi)} bit for bit, from one evaluation of the BSDF.
+    BsdfEval eval_pdf(vec3 wi, TransportMode mode = TransportMode::Radiance) const {
+        if constexpr (!DiffuseOnly)
+            if (is_wrapped) return wrapped.eval_pdf_w(wo, wi, mode);
+        return eval_pdf_in<DiffuseOnly>(*bsdf, wo, wi, mode);
+    }
     // The density with another wo (BDPT's reverse pdfs: the path walked the other way).
     float pdf_from(vec3 wo_other, vec3 wi, TransportMode mode) const {
         if constexpr (!DiffuseOnly)

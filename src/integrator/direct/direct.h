@@ -103,7 +103,8 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             LightSample ls;
             if (!sc.lights.sample_li(si.p, ul, up, ls) || !(ls.pdf > 0.f)) continue;
             const vec3 wi = frame.to_local(ls.wi);
-            const vec3 f = sh.eval(wi);
+            const BsdfEval e = sh.eval_pdf(wi);
+            const vec3 f = e.f;
             if (is_black(f)) continue;
             Ray shadow = shadow_ray(si, ls);
             ++stats.rays;
@@ -113,7 +114,7 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             // mis_weight(...) * m_weight_lum)`): it is NOT divided by emitter_samples, so with n_l
             // light samples a delta light counts n_l times. Kept for agreement with Mitsuba
             // (docs/lights.md); the smooth lights get 1 / n_l.
-            const float w = ls.delta ? 1.f : mis_weight(ls.pdf * frac_light_, sh.pdf(wi) * frac_bsdf_) * weight_light_;
+            const float w = ls.delta ? 1.f : mis_weight(ls.pdf * frac_light_, e.pdf * frac_bsdf_) * weight_light_;
             L += f * ls.Le * (T * w / ls.pdf);
         }
     } else {
