@@ -111,11 +111,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             LightSample ls;
             if (sc.lights.sample_li(si.p, ul, up, ls)) {
                 vec3 wi = sh.frame.to_local(ls.wi);
-                // f and, for MIS, the pdf from one evaluation of the BSDF; the diffuse-only loop
-                // takes its pdf (one product) only when the shadow ray gets through.
-                BsdfEval e;
-                if constexpr (DiffuseOnly) e.f = sh.eval(wi);
-                else e = sh.eval_pdf(wi);
+                const BsdfEval e = sh.eval_pdf(wi);  // f, and the pdf for MIS, from one evaluation
                 const vec3 f = e.f;
                 if (!is_black(f)) {
                     Ray shadow = shadow_ray(si, ls);
@@ -123,7 +119,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                     const float T = shadow_transmittance(sc, shadow, !DiffuseOnly && masks_, stats.rays);
                     if (T > 0.f) {
                         // A delta light cannot be reached by BSDF sampling: no MIS.
-                        float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, (DiffuseOnly ? sh.pdf(wi) : e.pdf) * T) : 1.f;
+                        float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
                         L += beta * f * ls.Le * (T * w / ls.pdf);
                     }
                 }
