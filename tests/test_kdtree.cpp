@@ -376,6 +376,33 @@ TEST(KdTree, BunnyMatchesBruteForce) {
     check_all(m, 6000, 3, "bunny");
 }
 
+// Leaves of more than eight triangles are split into groups with boxes of their own, one wide-node
+// lane each, where lanes are free. Large leaves (a low triangle cost) make many such splits; the hits
+// must still be brute force's, and a tree that is one leaf keeps its single lane.
+TEST(KdTree, LeavesSplitIntoLanesMatchBruteForce) {
+    Mesh m;
+    CANDELA_REQUIRE_SHARED_MESH(shared_mesh("bunny.obj"));
+    ASSERT_TRUE(load_obj(shared_mesh("bunny.obj"), m));
+    std::vector<Ray> rays = make_rays(m, 6000, 11);
+    Reference ref = brute_force(m, rays);
+    for (float ki : {0.02f, 0.1f}) {
+        KdBuildOptions opt;
+        opt.intersection_cost = ki;
+        KdTreeAccel kd(m, opt);
+        const KdTreeStats& s = kd.tree().stats();
+        EXPECT_GT(s.leaf_lanes, s.leaves - s.empty_leaves + s.leaves / 10) << "KI " << ki << ": few leaves were split";
+        expect_matches(kd, m, rays, ref, "bunny, KI " + std::to_string(ki));
+    }
+    Mesh soup = random_soup(40, 5);
+    KdBuildOptions one_leaf;
+    one_leaf.intersection_cost = 0.001f;  // no split pays: the tree is a single leaf of 40
+    KdTreeAccel kd(soup, one_leaf);
+    EXPECT_EQ(kd.tree().stats().leaves, 1u);
+    EXPECT_EQ(kd.tree().stats().leaf_lanes, 1u);
+    std::vector<Ray> soup_rays = make_rays(soup, 4000, 12);
+    expect_matches(kd, soup, soup_rays, brute_force(soup, soup_rays), "one-leaf soup");
+}
+
 TEST(KdTree, DragonMatchesBruteForce) {
     Mesh m;
     CANDELA_REQUIRE_SHARED_MESH(shared_mesh("dragon_100k.obj"));

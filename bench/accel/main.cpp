@@ -288,8 +288,8 @@ Built build(const std::string& name, const Mesh& mesh) {
     b.build_s = now() - t0;
     if (auto* kd = dynamic_cast<const KdTreeAccel*>(b.accel.get())) {
         const KdTreeStats& s = kd->tree().stats();
-        std::fprintf(stderr, "[%s] nodes %zu (%zu wide) leaves %zu (empty %zu) refs/tri %.2f refs/leaf %.2f depth %d\n",
-                     name.c_str(), s.nodes, s.wide_nodes, s.leaves, s.empty_leaves, double(s.references) / double(std::max<size_t>(1, mesh.triangles.size())),
+        std::fprintf(stderr, "[%s] nodes %zu (%zu wide) leaves %zu (empty %zu, in %zu lanes) refs/tri %.2f refs/leaf %.2f depth %d\n",
+                     name.c_str(), s.nodes, s.wide_nodes, s.leaves, s.empty_leaves, s.leaf_lanes, double(s.references) / double(std::max<size_t>(1, mesh.triangles.size())),
                      double(s.references) / double(std::max<size_t>(1, s.leaves - s.empty_leaves)), s.max_depth);
     }
     return b;

@@ -11,7 +11,8 @@
 // children, each boxed by what it holds, so that one vector step (8 lanes on AVX2, two of 4 on
 // SSE4 and NEON) tests all of a node's children and a ray takes a few wide steps instead of one
 // binary step per level; the SAH build, the leaves and the exact triangle test are the k-d
-// tree's. Empty leaves vanish. Traversal keeps a fixed stack, visits the children hit nearest first and skips
+// tree's. Empty leaves vanish; a large leaf's triangles are split into groups that take the lanes
+// left free, each under its own box. Traversal keeps a fixed stack, visits the children hit nearest first and skips
 // those beyond the closest hit; a template <bool Shadow> is the any-hit variant. It is compiled
 // per SIMD target (Highway) and chosen at run time. Leaves hold their triangles' vertices in
 // blocks of eight, laid out for the triangle test's lanes (a copy per leaf reference). Every
@@ -43,6 +44,7 @@ struct KdBuildOptions {
 struct KdTreeStats {
     size_t nodes = 0, leaves = 0, empty_leaves = 0, references = 0;  // of the binary tree built
     size_t wide_nodes = 0;                                             // after collapsing it
+    size_t leaf_lanes = 0;  // wide-node lanes holding leaf triangles: a leaf split into groups takes several
     int max_depth = 0;
 };
 
