@@ -363,12 +363,15 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
         std::unordered_map<const BuildNode*, AABB> box;
-        std::unordered_map<const BuildNode*, AABB> leaf_cell;
+        // Per leaf of more than eight triangles, the parts of its triangles in its cell (in prims'
+        // order), for splitting it into lanes without clipping again.
+        std::unordered_map<const BuildNode*, std::vector<AABB>> leaf_parts;
         // A lane of a wide node being made: an interior child, or a group of a leaf's triangles.
         struct Lane {
             const BuildNode* node;  // the interior child, or null for a group
             std::vector<uint32_t> prims;
-            AABB box, cell;
+            std::vector<AABB> parts;  // of a group that may be split: its triangles' parts in the cell
+            AABB box;
         };
 
         // The part of triangle p inside `cell`. Where the clipping finds nothing (a triangle only
@@ -393,8 +396,14 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                 ++t.stats_.leaves;
                 t.stats_.references += n->prims.size();
                 if (n->prims.empty()) ++t.stats_.empty_leaves;
-                for (uint32_t p : n->prims) b.expand(part_in(p, cell));
-                leaf_cell[n] = cell;
+                const bool large = n->prims.size() > KdTree::kBlockLanes;
+                std::vector<AABB> parts;
+                for (uint32_t p : n->prims) {
+                    const AABB c = part_in(p, cell);
+                    b.expand(c);
+                    if (large) parts.push_back(c);
+                }
+                if (large) leaf_parts[n] = std::move(parts);
             } else {
                 AABB lo = cell, hi = cell;
                 lo.max[n->axis] = n->split;
@@ -466,8 +475,13 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             // box, whose walls span every group's box, the step cost more than it saved.
             std::vector<Lane> lanes;
             for (const BuildNode* k : kids) {
-                if (k->axis < 0) lanes.push_back({nullptr, k->prims, box.at(k), leaf_cell.at(k)});
-                else lanes.push_back({k, {}, box.at(k), {}});
+                if (k->axis >= 0) {
+                    lanes.push_back({k, {}, {}, box.at(k)});
+                } else {
+                    auto it = leaf_parts.find(k);
+                    lanes.push_back({nullptr, k->prims, it == leaf_parts.end() ? std::vector<AABB>() : std::move(it->second),
+                                     box.at(k)});
+                }
             }
             while (n->axis >= 0 && lanes.size() < kLanes) {
                 int widest = -1;
@@ -512,8 +526,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             constexpr size_t kL = KdTree::kBlockLanes;
             const size_t n = g.prims.size();
             auto blocks = [](size_t m) { return (m + kL - 1) / kL; };
-            std::vector<AABB> part(n);
-            for (size_t i = 0; i < n; ++i) part[i] = part_in(g.prims[i], g.cell);
+            const std::vector<AABB>& part = g.parts;
             std::vector<size_t> order(n), best_order;
             std::vector<float> right_area(n + 1);
             float best_cost = kInfinity;
@@ -545,25 +558,19 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                 for (size_t i = 0; i < n; ++i) best_order[i] = i;
                 best_at = kL * (blocks(n) / 2);
             }
-            Lane second{nullptr, {}, AABB(), g.cell};
-            std::vector<uint32_t> first;
-            AABB fb;
+            Lane first{nullptr, {}, {}, AABB()}, second{nullptr, {}, {}, AABB()};
             for (size_t i = 0; i < n; ++i) {
                 const size_t j = best_order[i];
-                if (i < best_at) {
-                    first.push_back(g.prims[j]);
-                    fb.expand(part[j]);
-                } else {
-                    second.prims.push_back(g.prims[j]);
-                    second.box.expand(part[j]);
-                }
+                Lane& side = i < best_at ? first : second;
+                side.prims.push_back(g.prims[j]);
+                side.parts.push_back(part[j]);
+                side.box.expand(part[j]);
             }
-            g.prims = std::move(first);
-            g.box = fb;
+            g = std::move(first);
             return second;
         }
     };
-    Collapse c{*this, mesh, list, {}};
+    Collapse c{*this, mesh, list, {}, {}};
     c.boxes(root.get(), bounds_, 0);
     c.make(root.get());
     // One lane in the root, a leaf: its box test is the root box's (a leaf split into lanes is not).
