@@ -163,6 +163,32 @@ TEST(Triangle, RespectsTminAndTmax) {
     EXPECT_FALSE(hit(ray(vec3(0.2f, 0.3f, 1.f), -d, 1.001f, kInfinity), A, B, C));
 }
 
+// A triangle whose hit is below tmax is hit, even when tmax is only an ulp or two above it: the
+// check made before the division must not reject what the exact check after it accepts. Otherwise
+// the closest of two hits an ulp apart depends on the order of the tests. The case: a ray in the
+// plane of a room's back wall, aimed at the corner where it meets the floor and the left wall;
+// the left wall's triangle is hit at 0.99999994, the floor's at 0.99999988.
+TEST(Triangle, HitJustBelowTmaxIsKept) {
+    const vec3 o(4.3116416931152344f, 2.2160022258758545f, 5.5999999046325684f);
+    const vec3 d(-4.3116416931152344f, -2.2160022258758545f, 0.f);
+    const vec3 floor0(0.f, 0.f, 0.f), floor1(5.5f, 0.f, 5.6f), floor2(0.f, 0.f, 5.6f);
+    const vec3 left0(0.f, 0.f, 0.f), left1(0.f, 0.f, 5.6f), left2(0.f, 5.4f, 5.6f);
+    Ray r = ray(o, d, 0.f, kInfinity);
+    const RayShear sh(r.d);
+    TriangleHit fl, lw;
+    ASSERT_TRUE(intersect_triangle(r, sh, floor0, floor1, floor2, fl));
+    ASSERT_TRUE(intersect_triangle(r, sh, left0, left1, left2, lw));
+    ASSERT_LT(fl.t, lw.t) << "the floor is the closer of the two";
+    ASSERT_LT(lw.t - fl.t, 4e-7f) << "and only ulps closer";
+    r.tmax = lw.t;  // the left wall tested first
+    TriangleHit again;
+    ASSERT_TRUE(intersect_triangle(r, sh, floor0, floor1, floor2, again));
+    EXPECT_EQ(again.t, fl.t);
+    // The widened early check still rejects what is beyond tmax.
+    r.tmax = fl.t;
+    EXPECT_FALSE(intersect_triangle(r, sh, floor0, floor1, floor2, again));
+}
+
 // Zero-area triangles (coincident or collinear vertices) are never hit, whatever the ray, and
 // never produce a NaN.
 TEST(Triangle, DegenerateTrianglesAreNeverHit) {

@@ -158,11 +158,12 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     // not in the tree (KdTree::build leaves out zero_area_triangle()), so no lane needs that check.
     //
     // det = e0 + e1 + e2 and t_scaled = e0 z0 + e1 z1 + e2 z2, left to right as in the scalar test;
-    // then its comparisons with tmin det and tmax det, whose sense follows det's sign.
+    // then its comparisons with tmin det and tmax det (widened as intersect_triangle widens them),
+    // whose sense follows det's sign.
     const VL det = hn::Add(hn::Add(e0, e1), e2);
     const VL ts = hn::Add(hn::Add(hn::Mul(e0, z0), hn::Mul(e1, z1)), hn::Mul(e2, z2));
     const VL vtmin = hn::Set(d, tmin), vtmax = hn::Set(d, tmax);
-    const VL lo = hn::Mul(vtmin, det), hi = hn::Mul(vtmax, det);
+    const VL lo = hn::Mul(hn::Set(d, scaled_check_tmin(tmin)), det), hi = hn::Mul(hn::Set(d, scaled_check_tmax(tmax)), det);
     const ML out_neg = hn::And(hn::Lt(det, zero), hn::Or(hn::Ge(ts, lo), hn::Le(ts, hi)));
     const ML out_pos = hn::And(hn::Gt(det, zero), hn::Or(hn::Le(ts, lo), hn::Ge(ts, hi)));
     ML rejected = hn::Or(hn::Eq(det, zero), hn::Or(out_neg, out_pos));

@@ -34,6 +34,15 @@ inline bool zero_area_triangle(vec3 p0, vec3 p1, vec3 p2) {
     return n.x == 0.f && n.y == 0.f && n.z == 0.f;
 }
 
+// The bounds of the interval check made before the division (on t_scaled = t det), widened by
+// 2^-20 of their size. That check is only an early-out: the exact one is on t after the division.
+// Unwidened, the rounding of tmax det, 1 / det and t_scaled / det could make it reject a t that is
+// below tmax by an ulp or two, and which of two hits an ulp apart (at a vertex several triangles
+// share) is the closest would then depend on the order they are tested in. Widened, it rejects
+// only what the exact check rejects too. Also used by the k-d tree's SIMD test.
+inline float scaled_check_tmin(float tmin) { return tmin - std::abs(tmin) * 0x1p-20f; }
+inline float scaled_check_tmax(float tmax) { return tmax + std::abs(tmax) * 0x1p-20f; }
+
 // Returns true and fills `hit` when the ray meets the triangle with tmin < t < tmax.
 inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3 p1, vec3 p2, TriangleHit& hit) {
     // Translate to the ray origin and permute so that the largest direction component is z.
@@ -60,9 +69,10 @@ inline bool intersect_triangle(const Ray& ray, const RayShear& sh, vec3 p0, vec3
 
     float az = sh.sz * a[sh.kz], bz = sh.sz * b[sh.kz], cz = sh.sz * c[sh.kz];
     float t_scaled = e0 * az + e1 * bz + e2 * cz;
-    // Compare t against [tmin, tmax] without dividing: the signs follow det's.
-    if (det < 0.f && (t_scaled >= ray.tmin * det || t_scaled <= ray.tmax * det)) return false;
-    if (det > 0.f && (t_scaled <= ray.tmin * det || t_scaled >= ray.tmax * det)) return false;
+    // Compare t against [tmin, tmax] (widened) without dividing: the signs follow det's.
+    const float lo = scaled_check_tmin(ray.tmin) * det, hi = scaled_check_tmax(ray.tmax) * det;
+    if (det < 0.f && (t_scaled >= lo || t_scaled <= hi)) return false;
+    if (det > 0.f && (t_scaled <= lo || t_scaled >= hi)) return false;
 
     float inv_det = 1.f / det;
     float t = t_scaled * inv_det;
