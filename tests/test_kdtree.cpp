@@ -395,12 +395,48 @@ TEST(KdTree, LeavesSplitIntoLanesMatchBruteForce) {
     }
     Mesh soup = random_soup(40, 5);
     KdBuildOptions one_leaf;
-    one_leaf.intersection_cost = 0.001f;  // no split pays: the tree is a single leaf of 40
+    // No split pays, not even into lanes (a node step costs 125 blocks): one leaf of 40, one lane.
+    one_leaf.intersection_cost = 0.001f;
     KdTreeAccel kd(soup, one_leaf);
     EXPECT_EQ(kd.tree().stats().leaves, 1u);
     EXPECT_EQ(kd.tree().stats().leaf_lanes, 1u);
     std::vector<Ray> soup_rays = make_rays(soup, 4000, 12);
     expect_matches(kd, soup, soup_rays, brute_force(soup, soup_rays), "one-leaf soup");
+}
+
+// A room (an open-fronted box of five walls, each two triangles, and two blocks standing on its
+// floor: the Cornell box's layout) is small enough for the SAH to make it one leaf. That leaf's
+// triangles go into lanes of their own grouped as a BVH would (a flat box per wall), and the hits
+// must still be brute force's, for rays from the walls' own surfaces as a path tracer makes them.
+TEST(KdTree, OneLeafRoomSplitIntoLanesMatchesBruteForce) {
+    Mesh m;
+    auto quad = [&](vec3 a, vec3 b, vec3 c, vec3 d) {
+        add_tri(m, a, b, c);
+        add_tri(m, a, c, d);
+    };
+    const float W = 5.5f, H = 5.4f, D = 5.6f;
+    quad({0, 0, 0}, {W, 0, 0}, {W, 0, D}, {0, 0, D});  // floor
+    quad({0, H, 0}, {0, H, D}, {W, H, D}, {W, H, 0});  // ceiling
+    quad({0, 0, D}, {W, 0, D}, {W, H, D}, {0, H, D});  // back
+    quad({0, 0, 0}, {0, 0, D}, {0, H, D}, {0, H, 0});  // left
+    quad({W, 0, 0}, {W, H, 0}, {W, H, D}, {W, 0, D});  // right
+    auto block = [&](vec3 lo, vec3 hi) {
+        quad({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});  // top
+        quad({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z});
+        quad({lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z});
+        quad({lo.x, lo.y, lo.z}, {lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {lo.x, lo.y, hi.z});
+        quad({hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z});
+    };
+    block({0.8f, 0.f, 0.7f}, {2.4f, 1.65f, 2.7f});
+    block({2.9f, 0.f, 2.5f}, {4.6f, 3.3f, 4.5f});
+    KdTreeAccel kd(m);
+    const KdTreeStats& s = kd.tree().stats();
+    ASSERT_EQ(s.leaves, 1u) << "the room should be one leaf";
+    EXPECT_GE(s.leaf_lanes, 6u) << "the walls should have lanes of their own";
+    std::vector<Ray> rays = make_coherent_rays(m, 20000, 21);
+    std::vector<Ray> more = make_rays(m, 10000, 22);
+    rays.insert(rays.end(), more.begin(), more.end());
+    expect_matches(kd, m, rays, brute_force(m, rays), "room");
 }
 
 TEST(KdTree, DragonMatchesBruteForce) {

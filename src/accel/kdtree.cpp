@@ -373,6 +373,7 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             std::vector<AABB> parts;  // of a group that may be split: its triangles' parts in the cell
             AABB box;
         };
+        float node_blocks = 1.25f;  // a node step's cost in block tests, from the SAH's constants
 
         // The part of triangle p inside `cell`. Where the clipping finds nothing (a triangle only
         // touching the cell), the cell clipped to the triangle's bounds: still around the touching part.
@@ -396,7 +397,9 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                 ++t.stats_.leaves;
                 t.stats_.references += n->prims.size();
                 if (n->prims.empty()) ++t.stats_.empty_leaves;
-                const bool large = n->prims.size() > KdTree::kBlockLanes;
+                // The parts of the triangles of a leaf that may be split into lanes: one of more
+                // than a block, or a tree that is one leaf (split_root_leaf), for the split.
+                const bool large = n->prims.size() > (depth == 0 ? size_t(1) : size_t(KdTree::kBlockLanes));
                 std::vector<AABB> parts;
                 for (uint32_t p : n->prims) {
                     const AABB c = part_in(p, cell);
@@ -470,9 +473,8 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             // The lanes: the interior children, and the leaves' triangles in groups. A leaf of more
             // than eight triangles is split into groups, each in a lane of its own with the box of
             // its part of the cell, while lanes are free (the largest group first): a ray then tests
-            // only the blocks whose box it crosses, at no extra node step. Not a tree that is one
-            // leaf: it has no node step to share (its root box test is scalar), and on the Cornell
-            // box, whose walls span every group's box, the step cost more than it saved.
+            // only the blocks whose box it crosses, at no extra node step. A tree that is one leaf
+            // is split otherwise (split_root_leaf).
             std::vector<Lane> lanes;
             for (const BuildNode* k : kids) {
                 if (k->axis >= 0) {
@@ -483,15 +485,19 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                                      box.at(k)});
                 }
             }
-            while (n->axis >= 0 && lanes.size() < kLanes) {
-                int widest = -1;
-                for (size_t i = 0; i < lanes.size(); ++i)
-                    if (!lanes[i].node && lanes[i].prims.size() > kLanes &&
-                        (widest < 0 || lanes[i].prims.size() > lanes[size_t(widest)].prims.size()))
-                        widest = int(i);
-                if (widest < 0) break;
-                Lane second = split_group(lanes[size_t(widest)]);
-                lanes.push_back(std::move(second));
+            if (n->axis >= 0) {
+                while (lanes.size() < kLanes) {
+                    int widest = -1;
+                    for (size_t i = 0; i < lanes.size(); ++i)
+                        if (!lanes[i].node && lanes[i].prims.size() > kLanes &&
+                            (widest < 0 || lanes[i].prims.size() > lanes[size_t(widest)].prims.size()))
+                            widest = int(i);
+                    if (widest < 0) break;
+                    Lane second = split_group(lanes[size_t(widest)], SplitBy::KeptBlocks);
+                    lanes.push_back(std::move(second));
+                }
+            } else if (lanes.size() == 1) {
+                split_root_leaf(lanes);
             }
             WideNode w;
             for (int a = 0; a < 3; ++a)
@@ -519,18 +525,25 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
             return idx;
         }
 
-        // Splits a group of leaf triangles in two, in place, returning the second half: the split
-        // of least surface area heuristic cost (area times blocks, each side) among the orders of
-        // the triangles' part centroids along each axis, keeping the total number of blocks.
-        Lane split_group(Lane& g) {
-            constexpr size_t kL = KdTree::kBlockLanes;
+        static size_t blocks(size_t m) { return (m + KdTree::kBlockLanes - 1) / KdTree::kBlockLanes; }
+
+        // KeptBlocks: area times blocks, each side, among the splits with no more blocks in total
+        // than the group (memory unchanged). Triangles: area times triangles, each side, as a BVH
+        // build weighs them (blocks would hide the gain of splits that a further split completes:
+        // two walls of a room fill a block, as each one alone does).
+        enum class SplitBy { KeptBlocks, Triangles };
+
+        // The best split of a group of leaf triangles in two: the least surface area heuristic cost
+        // (`by`) among the orders of the triangles' part centroids along each axis. Returns the
+        // cost (infinite when there is none); the first `at` of `order` go to one side.
+        float split_plan(const Lane& g, SplitBy by, std::vector<size_t>& best_order, size_t& best_at) const {
             const size_t n = g.prims.size();
-            auto blocks = [](size_t m) { return (m + kL - 1) / kL; };
             const std::vector<AABB>& part = g.parts;
-            std::vector<size_t> order(n), best_order;
+            std::vector<size_t> order(n);
             std::vector<float> right_area(n + 1);
             float best_cost = kInfinity;
-            size_t best_at = 0;
+            best_at = 0;
+            best_order.clear();
             for (int a = 0; a < 3; ++a) {
                 for (size_t i = 0; i < n; ++i) order[i] = i;
                 std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
@@ -544,8 +557,13 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                 AABB l;
                 for (size_t i = 1; i < n; ++i) {
                     l.expand(part[order[i - 1]]);
-                    if (blocks(i) + blocks(n - i) != blocks(n)) continue;  // no block more than before
-                    const float cost = l.surface_area() * float(blocks(i)) + right_area[i] * float(blocks(n - i));
+                    float cost;
+                    if (by == SplitBy::Triangles) {
+                        cost = l.surface_area() * float(i) + right_area[i] * float(n - i);
+                    } else {
+                        if (blocks(i) + blocks(n - i) != blocks(n)) continue;
+                        cost = l.surface_area() * float(blocks(i)) + right_area[i] * float(blocks(n - i));
+                    }
                     if (cost < best_cost) {
                         best_cost = cost;
                         best_at = i;
@@ -553,24 +571,67 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                     }
                 }
             }
-            if (best_order.empty()) {  // every area NaN (cannot happen with finite vertices): halves in order
-                best_order = order;
-                for (size_t i = 0; i < n; ++i) best_order[i] = i;
-                best_at = kL * (blocks(n) / 2);
+            return best_cost;
+        }
+
+        // Splits a group in two as split_plan() says, in place, returning the second half.
+        Lane split_group(Lane& g, SplitBy by) const {
+            std::vector<size_t> order;
+            size_t at;
+            if (!(split_plan(g, by, order, at) < kInfinity)) {  // NaN areas: halves in order
+                order.resize(g.prims.size());
+                for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+                at = KdTree::kBlockLanes * (blocks(order.size()) / 2);
             }
             Lane first{nullptr, {}, {}, AABB()}, second{nullptr, {}, {}, AABB()};
-            for (size_t i = 0; i < n; ++i) {
-                const size_t j = best_order[i];
-                Lane& side = i < best_at ? first : second;
+            for (size_t i = 0; i < order.size(); ++i) {
+                const size_t j = order[i];
+                Lane& side = i < at ? first : second;
                 side.prims.push_back(g.prims[j]);
-                side.parts.push_back(part[j]);
-                side.box.expand(part[j]);
+                side.parts.push_back(g.parts[j]);
+                side.box.expand(g.parts[j]);
             }
             g = std::move(first);
             return second;
         }
+
+        // A tree that is one leaf (a small scene: the Cornell box is 32 triangles) has no node step:
+        // a ray tests the root box, then every block. Its triangles may instead go into up to eight
+        // groups under boxes of their own, grouped as a BVH would group them (split by triangle
+        // count, the group that gains most first): a ray then pays one node step and tests the
+        // groups whose box it crosses. In a room, a wall's group has a flat box that a ray crosses
+        // only where it hits the wall. Kept when the SAH in block tests says it pays: the groups'
+        // area x blocks plus a node step over the root box, against the leaf's area x blocks. The
+        // groups are partly filled blocks: more memory, for a small scene.
+        void split_root_leaf(std::vector<Lane>& lanes) const {
+            const std::vector<Lane> leaf = lanes;
+            while (lanes.size() < KdTree::kBlockLanes) {
+                int best = -1;
+                float best_gain = 0.f;
+                for (size_t i = 0; i < lanes.size(); ++i) {
+                    const Lane& l = lanes[i];
+                    if (l.prims.size() < 2) continue;
+                    std::vector<size_t> order;
+                    size_t at;
+                    const float gain =
+                        l.box.surface_area() * float(l.prims.size()) - split_plan(l, SplitBy::Triangles, order, at);
+                    if (gain > best_gain) {
+                        best_gain = gain;
+                        best = int(i);
+                    }
+                }
+                if (best < 0) break;
+                Lane second = split_group(lanes[size_t(best)], SplitBy::Triangles);
+                lanes.push_back(std::move(second));
+            }
+            const float root_area = leaf[0].box.surface_area();
+            float split = root_area * node_blocks;
+            for (const Lane& l : lanes) split += l.box.surface_area() * float(blocks(l.prims.size()));
+            if (!(split < root_area * float(blocks(leaf[0].prims.size())))) lanes = leaf;
+        }
     };
     Collapse c{*this, mesh, list, {}, {}};
+    c.node_blocks = opt.traversal_cost / (opt.intersection_cost * float(kBlockLanes));
     c.boxes(root.get(), bounds_, 0);
     c.make(root.get());
     // One lane in the root, a leaf: its box test is the root box's (a leaf split into lanes is not).

@@ -12,7 +12,8 @@
 // SSE4 and NEON) tests all of a node's children and a ray takes a few wide steps instead of one
 // binary step per level; the SAH build, the leaves and the exact triangle test are the k-d
 // tree's. Empty leaves vanish; a large leaf's triangles are split into groups that take the lanes
-// left free, each under its own box. Traversal keeps a fixed stack, visits the children hit nearest first and skips
+// left free, each under its own box, and a tree that is one leaf (a small scene) may be grouped
+// into lanes as a BVH would group it. Traversal keeps a fixed stack, visits the children hit nearest first and skips
 // those beyond the closest hit; a template <bool Shadow> is the any-hit variant. It is compiled
 // per SIMD target (Highway) and chosen at run time. Leaves hold their triangles' vertices in
 // blocks of eight, laid out for the triangle test's lanes (a copy per leaf reference). Every
