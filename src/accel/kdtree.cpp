@@ -363,8 +363,8 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         const Mesh& mesh;
         const std::vector<uint32_t>& list;
         std::unordered_map<const BuildNode*, AABB> box;
-        // Per leaf of more than eight triangles, the parts of its triangles in its cell (in prims'
-        // order), for splitting it into lanes without clipping again.
+        // Per leaf that may be split into lanes (see boxes()), the parts of its triangles in its
+        // cell (in prims' order), for the split without clipping again.
         std::unordered_map<const BuildNode*, std::vector<AABB>> leaf_parts;
         // A lane of a wide node being made: an interior child, or a group of a leaf's triangles.
         struct Lane {
