@@ -120,8 +120,20 @@ inline unsigned lane_bits(ML m) {
 struct BlockHits {
     alignas(32) float t[kLanes], b1[kLanes], b2[kLanes];
 };
+// The ray's open interval (tmin, tmax) and the widened bounds of the check before the division
+// (scaled_check_tmin/tmax), kept per ray rather than recomputed per block: tmin is fixed and tmax
+// changes only at a closer hit (set_tmax).
+struct Interval {
+    float tmin, tmax, check_lo, check_hi;
+    explicit Interval(const Ray& ray)
+        : tmin(ray.tmin), tmax(ray.tmax), check_lo(scaled_check_tmin(ray.tmin)), check_hi(scaled_check_tmax(ray.tmax)) {}
+    void set_tmax(float t) {
+        tmax = t;
+        check_hi = scaled_check_tmax(t);
+    }
+};
 // Lanes c to c + kStep - 1 of the block (bit 0 is lane c).
-inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, float tmin, float tmax, unsigned lanes,
+inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, const Interval& iv, unsigned lanes,
                           unsigned& scalar, BlockHits& out) {
     const DL d;
     // Vectors one by one, not in arrays: SVE vectors are sizeless and cannot be array elements.
@@ -162,8 +174,8 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
     // whose sense follows det's sign.
     const VL det = hn::Add(hn::Add(e0, e1), e2);
     const VL ts = hn::Add(hn::Add(hn::Mul(e0, z0), hn::Mul(e1, z1)), hn::Mul(e2, z2));
-    const VL vtmin = hn::Set(d, tmin), vtmax = hn::Set(d, tmax);
-    const VL lo = hn::Mul(hn::Set(d, scaled_check_tmin(tmin)), det), hi = hn::Mul(hn::Set(d, scaled_check_tmax(tmax)), det);
+    const VL vtmin = hn::Set(d, iv.tmin), vtmax = hn::Set(d, iv.tmax);
+    const VL lo = hn::Mul(hn::Set(d, iv.check_lo), det), hi = hn::Mul(hn::Set(d, iv.check_hi), det);
     const ML out_neg = hn::And(hn::Lt(det, zero), hn::Or(hn::Ge(ts, lo), hn::Le(ts, hi)));
     const ML out_pos = hn::And(hn::Gt(det, zero), hn::Or(hn::Le(ts, lo), hn::Ge(ts, hi)));
     ML rejected = hn::Or(hn::Eq(det, zero), hn::Or(out_neg, out_pos));
@@ -202,29 +214,29 @@ inline unsigned hits_step(const RayData& r, const KdTree::TriBlock& b, int c, fl
 }
 
 // The whole block, a step at a time; `lanes` holds its lanes in use (bit k is lane k).
-inline unsigned triangle_hits(const RayData& r, const KdTree::TriBlock& b, float tmin, float tmax, unsigned lanes,
+inline unsigned triangle_hits(const RayData& r, const KdTree::TriBlock& b, const Interval& iv, unsigned lanes,
                               unsigned& scalar, BlockHits& out) {
-    if constexpr (kStep == kLanes) return hits_step(r, b, 0, tmin, tmax, lanes, scalar, out);
+    if constexpr (kStep == kLanes) return hits_step(r, b, 0, iv, lanes, scalar, out);
     unsigned hits = 0;
     scalar = 0;
     for (int c = 0; c < kLanes; c += kStep) {
         const unsigned step_lanes = lanes >> c & kStepMask;
         if (!step_lanes) break;  // the block's unused lanes are its last ones
         unsigned step_scalar;
-        hits |= hits_step(r, b, c, tmin, tmax, step_lanes, step_scalar, out) << c;
+        hits |= hits_step(r, b, c, iv, step_lanes, step_scalar, out) << c;
         scalar |= step_scalar << c;
     }
     return hits;
 }
 
 // The triangles of a leaf (`count` of them from block `b`) against the ray: records a closer hit
-// in ray.tmax, `tmax`, *hit and `found`; with Shadow, returns true at the first hit.
+// in ray.tmax, `iv`, *hit and `found`; with Shadow, returns true at the first hit.
 template <bool Shadow>
 inline bool test_leaf(const RayData& r, const RayShear& sh, const KdTree::TriBlock* b, uint32_t count, Ray& ray, Hit* hit,
-                      float& tmax, bool& found) {
+                      Interval& iv, bool& found) {
     KD_COUNT(tris, count);
     auto record = [&](float t, float b1, float b2, uint32_t prim) {
-        tmax = t;
+        iv.set_tmax(t);
         ray.tmax = t;
         hit->t = t;
         hit->b1 = b1;
@@ -236,7 +248,7 @@ inline bool test_leaf(const RayData& r, const RayShear& sh, const KdTree::TriBlo
         const uint32_t n = std::min(count - i, uint32_t(kLanes));
         unsigned scalar;
         BlockHits bh;
-        const unsigned hits = triangle_hits(r, *b, ray.tmin, ray.tmax, (1u << n) - 1u, scalar, bh);
+        const unsigned hits = triangle_hits(r, *b, iv, (1u << n) - 1u, scalar, bh);
         if (Shadow && hits) return true;
         // In lane order, as the scalar test would meet them: a later lane replaces an earlier hit
         // only when strictly closer. Lanes with an edge function exactly 0 go to the shared scalar
@@ -252,7 +264,7 @@ inline bool test_leaf(const RayData& r, const RayShear& sh, const KdTree::TriBlo
                 if constexpr (Shadow) return true;
                 record(th.t, th.b1, th.b2, b->prim[k]);
             } else if constexpr (!Shadow) {
-                if (bh.t[k] < ray.tmax) record(bh.t[k], bh.b1[k], bh.b2[k], b->prim[k]);
+                if (bh.t[k] < iv.tmax) record(bh.t[k], bh.b1[k], bh.b2[k], b->prim[k]);
             }
         }
     }
@@ -290,13 +302,13 @@ bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const 
     KD_COUNT(rays, 1);
     const RayShear sh(ray.d);
     const RayData r(ray, sh);
-    float tmax = ray.tmax;
+    Interval iv(ray);
     bool found = false;
     if (leaf_root) {
         float t0, t1;
         if (!leaf_root->intersect(ray, vec3(r.inv_d[0], r.inv_d[1], r.inv_d[2]), t0, t1)) return false;
         KD_COUNT(leaves, 1);
-        return test_leaf<Shadow>(r, sh, blocks + nodes[0].child[0], nodes[0].count[0], ray, hit, tmax, found) ||
+        return test_leaf<Shadow>(r, sh, blocks + nodes[0].child[0], nodes[0].count[0], ray, hit, iv, found) ||
                found;
     }
     struct Entry {
@@ -325,7 +337,7 @@ bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const 
         const float* base = &nodes[cur].lo[0][0];
         alignas(32) float tn[kLanes];
         unsigned bits = 0;
-        const VL tmax_v = hn::Set(d, tmax);
+        const VL tmax_v = hn::Set(d, iv.tmax);
         for (int c = 0; c < kLanes; c += kStep) {
             VL tnear = tmin, tfar = tmax_v;
             slab(d, base + near_off[0] + c, base + far_off[0] + c, ox, ix, tnear, tfar);
@@ -380,7 +392,7 @@ bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const 
             if (!have) {
                 if (sp == 0) return found;
                 next = st[--sp];
-                if (!Shadow && next.t > tmax * kWidenUp) continue;
+                if (!Shadow && next.t > iv.tmax * kWidenUp) continue;
             }
             have = false;
             if (next.count == KdTree::kWideInterior) {
@@ -388,7 +400,7 @@ bool trace(const KdTree::WideNode* nodes, const KdTree::TriBlock* blocks, const 
                 break;
             }
             KD_COUNT(leaves, 1);
-            if (test_leaf<Shadow>(r, sh, blocks + next.child, next.count, ray, hit, tmax, found)) return true;
+            if (test_leaf<Shadow>(r, sh, blocks + next.child, next.count, ray, hit, iv, found)) return true;
         }
     }
 }
