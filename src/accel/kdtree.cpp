@@ -493,7 +493,8 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                             (widest < 0 || lanes[i].prims.size() > lanes[size_t(widest)].prims.size()))
                             widest = int(i);
                     if (widest < 0) break;
-                    Lane second = split_group(lanes[size_t(widest)], SplitBy::KeptBlocks);
+                    Lane& split = lanes[size_t(widest)];
+                    Lane second = split_group(split, split_plan(split, SplitBy::KeptBlocks));
                     lanes.push_back(std::move(second));
                 }
             } else if (lanes.size() == 1) {
@@ -534,21 +535,30 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         enum class SplitBy { KeptBlocks, Triangles };
 
         // The best split of a group of leaf triangles in two: the least surface area heuristic cost
-        // (`by`) among the orders of the triangles' part centroids along each axis. Returns the
-        // cost (infinite when there is none); the first `at` of `order` go to one side.
-        float split_plan(const Lane& g, SplitBy by, std::vector<size_t>& best_order, size_t& best_at) const {
+        // (`by`) among the orders of the triangles' part centroids along each axis (centroid_order).
+        // The first `at` triangles of that axis' order go to one side; no split: infinite cost,
+        // axis -1.
+        struct SplitPlan {
+            float cost = kInfinity;
+            int axis = -1;
+            size_t at = 0;
+        };
+        static std::vector<size_t> centroid_order(const Lane& g, int a) {
+            std::vector<size_t> order(g.prims.size());
+            for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+            const std::vector<AABB>& part = g.parts;
+            std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+                return part[x].min[a] + part[x].max[a] < part[y].min[a] + part[y].max[a];
+            });
+            return order;
+        }
+        SplitPlan split_plan(const Lane& g, SplitBy by) const {
             const size_t n = g.prims.size();
             const std::vector<AABB>& part = g.parts;
-            std::vector<size_t> order(n);
             std::vector<float> right_area(n + 1);
-            float best_cost = kInfinity;
-            best_at = 0;
-            best_order.clear();
+            SplitPlan best;
             for (int a = 0; a < 3; ++a) {
-                for (size_t i = 0; i < n; ++i) order[i] = i;
-                std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
-                    return part[x].min[a] + part[x].max[a] < part[y].min[a] + part[y].max[a];
-                });
+                const std::vector<size_t> order = centroid_order(g, a);
                 AABB r;
                 for (size_t i = n; i-- > 0;) {
                     r.expand(part[order[i]]);
@@ -564,21 +574,20 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
                         if (blocks(i) + blocks(n - i) != blocks(n)) continue;
                         cost = l.surface_area() * float(blocks(i)) + right_area[i] * float(blocks(n - i));
                     }
-                    if (cost < best_cost) {
-                        best_cost = cost;
-                        best_at = i;
-                        best_order = order;
-                    }
+                    if (cost < best.cost) best = SplitPlan{cost, a, i};
                 }
             }
-            return best_cost;
+            return best;
         }
 
-        // Splits a group in two as split_plan() says, in place, returning the second half.
-        Lane split_group(Lane& g, SplitBy by) const {
+        // Splits a group in two as `plan` (split_plan() of it) says, in place, returning the second
+        // half.
+        static Lane split_group(Lane& g, const SplitPlan& plan) {
             std::vector<size_t> order;
-            size_t at;
-            if (!(split_plan(g, by, order, at) < kInfinity)) {  // NaN areas: halves in order
+            size_t at = plan.at;
+            if (plan.axis >= 0) {
+                order = centroid_order(g, plan.axis);
+            } else {  // NaN areas: halves in order
                 order.resize(g.prims.size());
                 for (size_t i = 0; i < order.size(); ++i) order[i] = i;
                 at = KdTree::kBlockLanes * (blocks(order.size()) / 2);
@@ -605,23 +614,25 @@ void KdTree::build(const Mesh& mesh, const std::vector<uint32_t>* tris, const AA
         // groups are partly filled blocks: more memory, for a small scene.
         void split_root_leaf(std::vector<Lane>& lanes) const {
             const std::vector<Lane> leaf = lanes;
+            // One plan per lane (a group of fewer than two triangles has no parts, and no split).
+            auto plan = [&](const Lane& l) { return l.prims.size() < 2 ? SplitPlan{} : split_plan(l, SplitBy::Triangles); };
+            std::vector<SplitPlan> plans{plan(lanes[0])};
             while (lanes.size() < KdTree::kBlockLanes) {
                 int best = -1;
                 float best_gain = 0.f;
                 for (size_t i = 0; i < lanes.size(); ++i) {
                     const Lane& l = lanes[i];
-                    if (l.prims.size() < 2) continue;
-                    std::vector<size_t> order;
-                    size_t at;
-                    const float gain =
-                        l.box.surface_area() * float(l.prims.size()) - split_plan(l, SplitBy::Triangles, order, at);
+                    const float gain = l.box.surface_area() * float(l.prims.size()) - plans[i].cost;
                     if (gain > best_gain) {
                         best_gain = gain;
                         best = int(i);
                     }
                 }
                 if (best < 0) break;
-                Lane second = split_group(lanes[size_t(best)], SplitBy::Triangles);
+                Lane& split = lanes[size_t(best)];
+                Lane second = split_group(split, plans[size_t(best)]);
+                plans[size_t(best)] = plan(split);
+                plans.push_back(plan(second));
                 lanes.push_back(std::move(second));
             }
             const float root_area = leaf[0].box.surface_area();
