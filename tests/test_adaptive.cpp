@@ -263,8 +263,7 @@ TEST(Adaptive, PassHalvesEstimateTheImageError) {
         t.reset(w, 0, 0, 16, 16, 0);
         for (int y = 0; y < 16; ++y)
             for (int x = 0; x < 16; ++x) {
-                t.sum[size_t(y * 16 + x)] = dvec3(k == 0 ? 2.0 : 4.0);  // weight 2: values 1 and 2
-                t.weight[size_t(y * 16 + x)] = 2.0;
+                t.sum_weight[size_t(y * 16 + x)] = dvec4(dvec3(k == 0 ? 2.0 : 4.0), 2.0);  // weight 2: values 1 and 2
                 w.count_sample(ivec2(x, y));
             }
         w.merge(t);

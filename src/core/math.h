@@ -14,6 +14,7 @@ using glm::vec3;
 using glm::ivec2;
 using glm::uvec3;
 using glm::dvec3;
+using glm::dvec4;
 using glm::mat4;
 
 constexpr float kPi = 3.14159265358979323846f;

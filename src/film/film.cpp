@@ -65,8 +65,8 @@ void Film::merge(const FilmTile& t) {
         for (int x = 0; x < t.width; ++x) {
             const size_t j = size_t(y) * size_t(t.width) + size_t(x);
             const size_t i = size_t(t.y0 + y) * size_t(width_) + size_t(t.x0 + x);
-            sum_[i] += t.sum[j];
-            weight_[i] += t.weight[j];
+            sum_[i] += dvec3(t.sum_weight[j]);
+            weight_[i] += t.sum_weight[j].w;
             if (alpha_enabled_) alpha_[i] += t.alpha[j];
             for (int k = 0; k < aov_channels_; ++k)
                 aov_[i * size_t(aov_channels_) + size_t(k)] += t.aov[j * size_t(aov_channels_) + size_t(k)];
@@ -105,8 +105,7 @@ void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int m
     height = std::min(film.height(), ty1 + margin) - y0;
     aov_channels = film.aov_channels();
     const size_t n = size_t(width) * size_t(height);
-    sum.assign(n, dvec3(0.0));
-    weight.assign(n, 0.0);
+    sum_weight.assign(n, dvec4(0.0));
     aov.assign(n * size_t(aov_channels), 0.0);
     if (film.has_alpha()) alpha.assign(n, 0.0);
     else alpha.clear();

@@ -219,8 +219,9 @@ struct SplatTile {
 struct FilmTile {
     int x0 = 0, y0 = 0, width = 0, height = 0;  // the region covered, film pixels
     int aov_channels = 0;
-    std::vector<dvec3> sum;
-    std::vector<double> weight, aov;
+    // Per pixel, sum(w L) in xyz and sum(w) in w: one place for the two sums each splat adds to.
+    std::vector<dvec4> sum_weight;
+    std::vector<double> aov;
     std::vector<double> alpha;  // when the film has alpha: coverage x weight
 
     // Covers the film pixels [x0 - margin, x1 + margin) x [y0 - margin, y1 + margin) clipped to the
