@@ -5,7 +5,8 @@
 #
 # Usage: bash bench/mitsuba/compare.sh [SCENE.xml] [--res N] [--spp N] [--max-depth M] [--threads T]
 #                                      [--embree-build DIR]
-#   SCENE defaults to scenes/cornell-box/scene.xml; --max-depth is MITSUBA's max_depth (path
+#   SCENE defaults to scenes/cornell-box/scene.xml. Each -D goes only to a scene that declares it
+#   (a published scene keeps its own size or depth when it has no parameter for them); --max-depth is MITSUBA's max_depth (path
 #   segments; candela gets M - 1 through the XML); default 8, i.e. 7 scattering events.
 #   --embree-build DIR: a build configured with -DCANDELA_EMBREE=ON; its candela renders the scene
 #   with the k-d tree and with Embree, in turn, and the ratio says how much of the distance to
@@ -31,7 +32,12 @@ eval "$(bash $shared/setup-reference.sh --no-apt | grep '^PY=')"
 bash scripts/build.sh >/dev/null
 out=out/bench-mitsuba
 mkdir -p "$out"
-defs=(-D "res=$res" -D "width=$res" -D "height=$res" -D "spp=$spp" -D "max_depth=$depth")
+# Only the parameters the scene declares (<default name=...>): Mitsuba refuses unused ones, and
+# published scenes name their resolution res, width/height or resx/resy.
+defs=()
+for kv in "res=$res" "width=$res" "height=$res" "resx=$res" "resy=$res" "spp=$spp" "max_depth=$depth"; do
+  grep -q "<default[^>]*name=\"${kv%%=*}\"" "$scene" && defs+=(-D "$kv")
+done
 
 echo "scene=$scene res=${res}x${res} spp=$spp mitsuba_max_depth=$depth threads=$threads machine=$(lscpu | sed -n 's/^Model name: *//p')"
 # candela BINARY OUT.exr [ARGS...]: renders the scene, prints candela's summary line.
