@@ -61,3 +61,78 @@ TEST(Staged, HiddenEmittersAndOneThread) {
     std::shared_ptr<const Scene> s = box->with_params(p);
     expect_same_films(*s, 20, 20, 2, 1, 20 * 20 / 2, "hide_emitters");
 }
+
+#include <random>
+#include <hwy/targets.h>
+#include "integrator/path/hit_soa.h"
+#include "scene/loaders.h"
+
+namespace {
+
+// Random hits on the scene's own triangles, reconstructed in lanes, against Scene::interaction.
+// Returns how many lanes had a shading normal other than the geometric one.
+int expect_same_interactions(const Scene& scene, const std::string& what) {
+    const Mesh& mesh = scene.mesh;
+    EXPECT_GT(mesh.triangle_count(), 0u);
+    std::vector<int32_t> smooth(scene.shapes.size());
+    for (size_t s = 0; s < scene.shapes.size(); ++s) smooth[s] = scene.shapes[s].smooth ? 1 : 0;
+    const size_t n = 1001, padded = (n + kHitBatchAlign - 1) / kHitBatchAlign * kHitBatchAlign;
+    std::vector<uint32_t> prim(padded, 0), shape(padded);
+    std::vector<float> b1(padded, 0.f), b2(padded, 0.f);
+    std::vector<float> f[12];
+    for (auto& v : f) v.assign(padded, 0.f);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (size_t i = 0; i < n; ++i) {
+        prim[i] = uint32_t(rng() % mesh.triangle_count());
+        float x = u(rng), y = u(rng);
+        if (x + y > 1.f) x = 1.f - x, y = 1.f - y;
+        b1[i] = x;
+        b2[i] = y;
+    }
+    reconstruct_triangle_hits(mesh, smooth.data(), n, HitBatch{prim.data(), b1.data(), b2.data()},
+                              SurfaceBatch{{f[0].data(), f[1].data(), f[2].data()},
+                                           {f[3].data(), f[4].data(), f[5].data()},
+                                           {f[6].data(), f[7].data(), f[8].data()},
+                                           {f[9].data(), f[10].data(), f[11].data()},
+                                           shape.data()});
+    int curved = 0;
+    for (size_t i = 0; i < n; ++i) {
+        Hit h;
+        h.prim = prim[i];
+        h.b1 = b1[i];
+        h.b2 = b2[i];
+        const SurfaceInteraction si = scene.interaction(h);
+        const vec3 got[4] = {vec3(f[0][i], f[1][i], f[2][i]), vec3(f[3][i], f[4][i], f[5][i]),
+                             vec3(f[6][i], f[7][i], f[8][i]), vec3(f[9][i], f[10][i], f[11][i])};
+        const vec3 want[4] = {si.p, si.p_error, si.ng, si.ns};
+        bool same = shape[i] == si.shape;
+        for (int k = 0; k < 4; ++k) same = same && std::memcmp(&got[k], &want[k], sizeof(vec3)) == 0;
+        if (!same) {
+            ADD_FAILURE() << what << ": lane " << i << " differs from Scene::interaction";
+            return curved;
+        }
+        curved += si.ns != si.ng;
+    }
+    return curved;
+}
+
+}  // namespace
+
+TEST(Staged, HitReconstructionInLanesMatchesScene) {
+    SceneOverrides ov;
+    ov.width = 8;
+    ov.height = 8;
+    auto box = prepare_scene("", ov);
+    // Smooth shading normals: matpreview's meshes.
+    auto mp = build_scene(load_scene(std::string(CANDELA_SHARED_DIR) + "/scenes-public/mdata_matpreview/matpreview.xml"));
+    struct Restore {
+        ~Restore() { hwy::SetSupportedTargetsForTest(0); }
+    } restore;
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        hwy::SetSupportedTargetsForTest(target);
+        const std::string name = hwy::TargetName(target);
+        EXPECT_EQ(expect_same_interactions(*box, "cornell box, " + name), 0);
+        EXPECT_GT(expect_same_interactions(*mp, "matpreview, " + name), 500) << "most lanes on smooth shapes";
+    }
+}
