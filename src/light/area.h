@@ -58,6 +58,12 @@ public:
     // f(Le, pdf) for each, Le the radiance arriving along -w (w the escaping ray's direction) and
     // pdf the solid-angle density with which sample_li picks w through that light (with its pmf).
     bool has_infinite() const { return !infinite_.empty(); }
+    // Whether some emitter's radiance is a texture (emitted() then reads the hit's uv).
+    bool has_textured_emitter() const {
+        for (const Texture* t : emitter_texture_)
+            if (t) return true;
+        return false;
+    }
     template <class F>
     void for_each_infinite(vec3 w, F&& f) const {
         for (uint32_t i : infinite_)

@@ -13,10 +13,11 @@
 // and its radiance is added to the film in the scalar loop's order: the image is the same bit for
 // bit. The stages run path by path for now; SoA state and SIMD stages are the next steps.
 //
-// Scope: the diffuse-only instantiation (no masks), an unweighted film (box filter) without
-// adaptive sampling, AOVs or alpha. render_pass_for falls back to the per-path loop otherwise.
+// Scope: the diffuse-only instantiation (no masks) without textures, an unweighted film (box
+// filter) without adaptive sampling, AOVs or alpha. render_pass_for falls back to the per-path loop otherwise.
 #include <vector>
 #include "integrator/path.h"
+#include "integrator/path/hit_soa.h"
 #include "integrator/tiles.h"
 
 namespace candela {
@@ -34,21 +35,34 @@ struct StagedPath {
     vec3 shadow_L{0.f};
 };
 
+// What trace_staged reuses from round to round (one per thread).
+struct StagedScratch {
+    std::vector<uint32_t> next, shadowed;
+    std::vector<uint32_t> hit_path;  // per hit of the round (dense): its path
+    std::vector<Hit> hits;
+    std::vector<uint8_t> batched;    // the hit went through reconstruct_triangle_hits
+    std::vector<uint32_t> prim, shape;
+    std::vector<float> b1, b2, f[12];
+    std::vector<int32_t> smooth;     // per shape
+};
+
 // Runs the paths whose indices are in `live` (emptied on return) to their end. Diffuse-only scenes
-// (scene_is_diffuse_only) only.
+// (scene_is_diffuse_only) without textures only (staged_pass_applies).
 template <class S>
 void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vector<uint32_t>& live,
-                  PathStats& stats) {
+                  StagedScratch& x, PathStats& stats) {
     const RenderSettings& st = sc.settings;
     const SamplingMode mode = st.sampling;
     const bool have_lights = !sc.lights.empty();
     ShadingT<true> sh;
-    std::vector<uint32_t> next, shadowed;
-    next.reserve(live.size());
-    shadowed.reserve(live.size());
+    x.smooth.resize(sc.shapes.size());
+    for (size_t s = 0; s < sc.shapes.size(); ++s) x.smooth[s] = sc.shapes[s].smooth ? 1 : 0;
     while (!live.empty()) {
-        next.clear();
-        shadowed.clear();
+        x.next.clear();
+        x.shadowed.clear();
+        x.hit_path.clear();
+        x.hits.clear();
+        // Stage 1: closest hits.
         for (const uint32_t i : live) {
             StagedPath<S>& p = paths[i];
             Hit hit;
@@ -60,7 +74,51 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
             }
             if (p.depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, p.ray, hit, stats)) continue;
             if (p.depth == 0) ++stats.camera_hits;
-            SurfaceInteraction si = sc.interaction(hit);
+            x.hit_path.push_back(i);
+            x.hits.push_back(hit);
+        }
+        // Stage 2a: hit reconstruction in SIMD lanes for the scene's own triangles (analytic shapes
+        // and instances: Scene::interaction, per hit).
+        const size_t m = x.hits.size();
+        const size_t padded = (m + kHitBatchAlign - 1) / kHitBatchAlign * kHitBatchAlign;
+        x.prim.assign(padded, 0u);
+        x.b1.assign(padded, 0.f);
+        x.b2.assign(padded, 0.f);
+        x.batched.assign(m, 0);
+        x.shape.resize(padded);
+        for (auto& v : x.f) v.resize(padded);
+        for (size_t j = 0; j < m; ++j) {
+            const Hit& h = x.hits[j];
+            if (h.kind != PrimKind::Triangle || h.instance != ~0u) continue;
+            x.batched[j] = 1;
+            x.prim[j] = h.prim;
+            x.b1[j] = h.b1;
+            x.b2[j] = h.b2;
+        }
+        if (m > 0)
+            reconstruct_triangle_hits(sc.mesh, x.smooth.data(), m, HitBatch{x.prim.data(), x.b1.data(), x.b2.data()},
+                                      SurfaceBatch{{x.f[0].data(), x.f[1].data(), x.f[2].data()},
+                                                   {x.f[3].data(), x.f[4].data(), x.f[5].data()},
+                                                   {x.f[6].data(), x.f[7].data(), x.f[8].data()},
+                                                   {x.f[9].data(), x.f[10].data(), x.f[11].data()},
+                                                   x.shape.data()});
+        // Stage 2b: per path, everything up to its next ray.
+        for (size_t j = 0; j < m; ++j) {
+            const uint32_t i = x.hit_path[j];
+            StagedPath<S>& p = paths[i];
+            const Hit& hit = x.hits[j];
+            SurfaceInteraction si;
+            if (x.batched[j]) {
+                // uv, dpdu and dpdv stay unset: nothing untextured and diffuse reads them.
+                si.p = vec3(x.f[0][j], x.f[1][j], x.f[2][j]);
+                si.p_error = vec3(x.f[3][j], x.f[4][j], x.f[5][j]);
+                si.ng = vec3(x.f[6][j], x.f[7][j], x.f[8][j]);
+                si.ns = vec3(x.f[9][j], x.f[10][j], x.f[11][j]);
+                si.prim = hit.prim;
+                si.shape = x.shape[j];
+            } else {
+                si = sc.interaction(hit);
+            }
             const vec3 wo_world = -glm::normalize(p.ray.d);
             if (sc.lights.emitter_of(hit) >= 0) {
                 const vec3 Le = sc.lights.emitted(si, wo_world);
@@ -89,7 +147,7 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
                         const float T = 1.f;
                         const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
                         p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
-                        shadowed.push_back(i);
+                        x.shadowed.push_back(i);
                     }
                 }
             } else if (mode != SamplingMode::Bsdf) {
@@ -113,22 +171,24 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
                 p.beta /= q;
             }
             ++p.depth;
-            next.push_back(i);
+            x.next.push_back(i);
         }
         // The round's shadow rays, in path order: their contributions come before the emission
         // the next round adds, as in Li.
-        for (const uint32_t i : shadowed) {
+        for (const uint32_t i : x.shadowed) {
             StagedPath<S>& p = paths[i];
             if (!sc.accel->occluded(p.shadow)) p.L += p.shadow_L;
         }
-        live.swap(next);
+        live.swap(x.next);
     }
 }
 
 // Whether render_tiles_staged can render this pass (see the scope above).
 inline bool staged_pass_applies(const Scene& scene, const Film& film) {
-    return scene_is_diffuse_only(scene) && !film.weighted() && !film.adaptive() && film.aov_channels() == 0 &&
-           !film.has_alpha();
+    if (!scene_is_diffuse_only(scene) || scene.lights.has_textured_emitter()) return false;
+    for (const Material& m : scene.materials)
+        if (m.textured()) return false;
+    return !film.weighted() && !film.adaptive() && film.aov_channels() == 0 && !film.has_alpha();
 }
 
 // render_tiles (tiles.h) for an unweighted film, a tile's paths at a time through trace_staged.
@@ -147,6 +207,7 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
     {
         std::vector<StagedPath<S>> paths;
         std::vector<uint32_t> live;
+        StagedScratch scratch;
 #pragma omp for schedule(dynamic, 1)
         for (int tile = 0; tile < n_tiles; ++tile) {
             if (stopped.load(std::memory_order_relaxed)) continue;
@@ -171,7 +232,7 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
                         live.push_back(uint32_t(paths.size()));
                         paths.push_back(p);
                     }
-            trace_staged(scene, paths, live, ps);
+            trace_staged(scene, paths, live, scratch, ps);
             size_t k = 0;
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x)
