@@ -2,7 +2,11 @@
 // the same film bit for bit.
 #include <gtest/gtest.h>
 #include <cstring>
+#include <random>
+#include <hwy/targets.h>
+#include "integrator/path/hit_soa.h"
 #include "integrator/path/wavefront.h"
+#include "scene/loaders.h"
 #include "integrator/sampled_pass.h"
 #include "render/launch.h"
 
@@ -38,13 +42,20 @@ TEST(Staged, SameFilmAsThePerPathLoop) {
     ov.height = 24;
     std::shared_ptr<const Scene> box = prepare_scene("", ov);  // the built-in Cornell box: all diffuse
     ASSERT_TRUE(scene_is_diffuse_only(*box));
+    struct Restore {
+        ~Restore() { hwy::SetSupportedTargetsForTest(0); }
+    } restore;
+    // The SIMD stages on every target this CPU runs (the k-d tree's too).
+    for (int64_t target : hwy::SupportedAndGeneratedTargets())
     for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Light, SamplingMode::Bsdf})
         for (int depth : {-1, 1, 2, 7}) {
+            hwy::SetSupportedTargetsForTest(target);
             SceneParams p = box->params();
             p.settings.sampling = mode;
             p.settings.max_depth = depth;
             std::shared_ptr<const Scene> s = box->with_params(p);
-            const std::string what = "mode " + std::to_string(int(mode)) + " depth " + std::to_string(depth);
+            const std::string what = std::string(hwy::TargetName(target)) + " mode " + std::to_string(int(mode)) +
+                                     " depth " + std::to_string(depth);
             // BSDF sampling alone lights a pixel only through paths that hit the small emitter.
             const int min_lit = mode == SamplingMode::Bsdf ? (depth == -1 || depth == 7 ? 30 : 1) : 40 * 24 / 2;
             expect_same_films(*s, 40, 24, 3, 2, min_lit, what.c_str());
@@ -62,10 +73,6 @@ TEST(Staged, HiddenEmittersAndOneThread) {
     expect_same_films(*s, 20, 20, 2, 1, 20 * 20 / 2, "hide_emitters");
 }
 
-#include <random>
-#include <hwy/targets.h>
-#include "integrator/path/hit_soa.h"
-#include "scene/loaders.h"
 
 namespace {
 

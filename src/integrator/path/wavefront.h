@@ -17,6 +17,7 @@
 // filter) without adaptive sampling, AOVs or alpha. render_pass_for falls back to the per-path loop otherwise.
 #include <vector>
 #include "integrator/path.h"
+#include "integrator/path/diffuse_step.h"
 #include "integrator/path/hit_soa.h"
 #include "integrator/tiles.h"
 
@@ -44,6 +45,10 @@ struct StagedScratch {
     std::vector<uint32_t> prim, shape;
     std::vector<float> b1, b2, f[12];
     std::vector<int32_t> smooth;     // per shape
+    // The diffuse step's lanes (diffuse_step.h): per lane, its path and its arrays.
+    std::vector<uint32_t> step_path;
+    std::vector<float> sf[9], wo_z, albedo[3], u[2], u_rr, eta_scale, sp[3], serr[3], sng[3], beta[3], pdf, o[3], dir[3];
+    std::vector<int32_t> rr, alive;
 };
 
 // Runs the paths whose indices are in `live` (emptied on return) to their end. Diffuse-only scenes
@@ -55,6 +60,18 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
     const SamplingMode mode = st.sampling;
     const bool have_lights = !sc.lights.empty();
     ShadingT<true> sh;
+    // The diffuse step's arrays: room for every path of the batch, padded.
+    const size_t cap = (paths.size() + kDiffuseStepAlign - 1) / kDiffuseStepAlign * kDiffuseStepAlign;
+    if (x.step_path.size() < cap) {
+        x.step_path.resize(cap);
+        for (auto& v : x.sf) v.resize(cap);
+        for (int k = 0; k < 3; ++k) {
+            for (auto* v : {&x.albedo[k], &x.sp[k], &x.serr[k], &x.sng[k], &x.beta[k], &x.o[k], &x.dir[k]}) v->resize(cap);
+        }
+        for (auto* v : {&x.wo_z, &x.u[0], &x.u[1], &x.u_rr, &x.eta_scale, &x.pdf}) v->resize(cap);
+        x.rr.resize(cap);
+        x.alive.resize(cap);
+    }
     x.smooth.resize(sc.shapes.size());
     for (size_t s = 0; s < sc.shapes.size(); ++s) x.smooth[s] = sc.shapes[s].smooth ? 1 : 0;
     while (!live.empty()) {
@@ -62,6 +79,7 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
         x.shadowed.clear();
         x.hit_path.clear();
         x.hits.clear();
+        size_t ns = 0;  // lanes of this round's diffuse step
         // Stage 1: closest hits.
         for (const uint32_t i : live) {
             StagedPath<S>& p = paths[i];
@@ -154,24 +172,76 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
                 p.sampler.next_1d();
                 p.sampler.next_2d();
             }
-            const float u1 = p.sampler.next_1d();
+            // The BSDF sample's numbers, and the roulette's when it applies: drawn now, in Li's
+            // order. Li skips the roulette draw only for a path that has ended, whose sampler is
+            // never used again, so drawing it first changes no number any path uses.
+            p.sampler.next_1d();  // u1: the diffuse BSDF has one lobe
             const vec2 u2 = p.sampler.next_2d();
-            const std::optional<BsdfSample> bs = sh.sample(u1, u2);
-            if (!bs || !(bs->pdf > 0.f)) continue;
-            p.beta *= bs->weight();
-            if (is_black(p.beta)) continue;
-            p.eta_scale *= sqr(bs->eta);
-            p.after_delta = bs->delta;
-            p.prev_pdf = bs->pdf;
-            p.prev_p = si.p;
-            p.ray = spawn_ray(si, sh.frame.to_world(bs->wi));
-            if (p.depth + 1 >= st.rr_depth) {
-                const float q = std::min(max_component(p.beta) * p.eta_scale, 0.95f);
-                if (p.sampler.next_1d() >= q) continue;
-                p.beta /= q;
+            const bool rr = p.depth + 1 >= st.rr_depth;
+            const float u_rr = rr ? p.sampler.next_1d() : 0.f;
+            const DiffuseBsdf& bsdf = std::get<DiffuseBsdf>(*sh.bsdf);
+            const size_t q = ns++;
+            x.step_path[q] = i;
+            for (int k = 0; k < 3; ++k) {
+                x.sf[k][q] = sh.frame.s[k];
+                x.sf[3 + k][q] = sh.frame.t[k];
+                x.sf[6 + k][q] = sh.frame.n[k];
+                x.albedo[k][q] = bsdf.albedo[k];
+                x.sp[k][q] = si.p[k];
+                x.serr[k][q] = si.p_error[k];
+                x.sng[k][q] = si.ng[k];
+                x.beta[k][q] = p.beta[k];
             }
-            ++p.depth;
-            x.next.push_back(i);
+            x.wo_z[q] = sh.wo.z;
+            x.u[0][q] = u2.x;
+            x.u[1][q] = u2.y;
+            x.u_rr[q] = u_rr;
+            x.rr[q] = rr ? 1 : 0;
+            x.eta_scale[q] = p.eta_scale;
+        }
+        // Stage 2c: the diffuse step in SIMD lanes (BSDF sample, throughput, next ray, roulette),
+        // then the paths that go on, in path order.
+        if (ns > 0) {
+            // Padding lanes up to the SIMD batch's multiple: finite values, results ignored.
+            const size_t padded_ns = (ns + kDiffuseStepAlign - 1) / kDiffuseStepAlign * kDiffuseStepAlign;
+            for (size_t q = ns; q < padded_ns; ++q) {
+                for (auto& v : x.sf) v[q] = 0.f;
+                for (int k = 0; k < 3; ++k) x.albedo[k][q] = x.sp[k][q] = x.serr[k][q] = x.sng[k][q] = x.beta[k][q] = 0.f;
+                x.wo_z[q] = x.u_rr[q] = 0.f;
+                x.u[0][q] = x.u[1][q] = 0.5f;
+                x.rr[q] = 0;
+                x.eta_scale[q] = 1.f;
+            }
+            diffuse_step(ns, DiffuseStepBatch{{x.sf[0].data(), x.sf[1].data(), x.sf[2].data()},
+                                              {x.sf[3].data(), x.sf[4].data(), x.sf[5].data()},
+                                              {x.sf[6].data(), x.sf[7].data(), x.sf[8].data()},
+                                              x.wo_z.data(),
+                                              {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
+                                              {x.u[0].data(), x.u[1].data()},
+                                              x.u_rr.data(),
+                                              x.rr.data(),
+                                              x.eta_scale.data(),
+                                              {x.sp[0].data(), x.sp[1].data(), x.sp[2].data()},
+                                              {x.serr[0].data(), x.serr[1].data(), x.serr[2].data()},
+                                              {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
+                                              {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
+                                              x.pdf.data(),
+                                              {x.o[0].data(), x.o[1].data(), x.o[2].data()},
+                                              {x.dir[0].data(), x.dir[1].data(), x.dir[2].data()},
+                                              x.alive.data()});
+            for (size_t j = 0; j < ns; ++j) {
+                if (!x.alive[j]) continue;
+                StagedPath<S>& p = paths[x.step_path[j]];
+                p.beta = vec3(x.beta[0][j], x.beta[1][j], x.beta[2][j]);
+                p.after_delta = false;
+                p.prev_pdf = x.pdf[j];
+                p.prev_p = vec3(x.sp[0][j], x.sp[1][j], x.sp[2][j]);
+                p.ray = Ray();
+                p.ray.o = vec3(x.o[0][j], x.o[1][j], x.o[2][j]);
+                p.ray.d = vec3(x.dir[0][j], x.dir[1][j], x.dir[2][j]);
+                ++p.depth;
+                x.next.push_back(x.step_path[j]);
+            }
         }
         // The round's shadow rays, in path order: their contributions come before the emission
         // the next round adds, as in Li.
