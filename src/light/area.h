@@ -58,6 +58,27 @@ public:
     // f(Le, pdf) for each, Le the radiance arriving along -w (w the escaping ray's direction) and
     // pdf the solid-angle density with which sample_li picks w through that light (with its pmf).
     bool has_infinite() const { return !infinite_.empty(); }
+    // The tables of sample_li for a vector copy of it (wavefront branch), when the lights are
+    // emissive triangles only, untextured, on a mesh without shading normals, each of non-zero
+    // pmf (sample_li is then sample_area_li's triangle case alone). Per entry of the distribution,
+    // `tri` holds 14 floats: p0, p1, p2, ng, pmf_area, pdf_area (EmissiveTriangle), and
+    // `radiance` 3.
+    struct AreaTriangleTables {
+        const float* cdf = nullptr;  // entries + 1 values
+        const float* pmf = nullptr;
+        size_t entries = 0;
+        const float* tri = nullptr;
+        const float* radiance = nullptr;
+    };
+    bool area_triangle_tables(AreaTriangleTables& out) const {
+        if (tris_.empty() || !alights_.empty() || !lights_.empty() || !mesh_->normals.empty() || has_textured_emitter())
+            return false;
+        for (size_t i = 0; i < dist_.size(); ++i)
+            if (!(dist_.pmf(i) > 0.f)) return false;
+        static_assert(sizeof(EmissiveTriangle) == 14 * sizeof(float), "EmissiveTriangle: 14 floats, no padding");
+        out = {dist_.cdf_data(), dist_.pmf_data(), dist_.size(), &etris_[0].p0.x, &radiance_[0].x};
+        return dist_.size() == tris_.size();
+    }
     // Whether some emitter's radiance is a texture (emitted() then reads the hit's uv).
     bool has_textured_emitter() const {
         for (const Texture* t : emitter_texture_)

@@ -29,6 +29,9 @@ public:
     bool empty() const { return pmf_.empty() || total_ <= 0; }
     double total() const { return total_; }
     float pmf(size_t i) const { return pmf_[i]; }
+    // The float CDF (size() + 1 entries, from 0) and the pmfs, for vector copies of sample().
+    const float* cdf_data() const { return cdf_f_.data(); }
+    const float* pmf_data() const { return pmf_.data(); }
 
     // Index i with cdf[i] <= u < cdf[i+1]; entries of zero weight are never returned.
     size_t sample(float u, float* pmf_out = nullptr, float* u_remapped = nullptr) const {

@@ -17,33 +17,45 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+// offset_ray_origin (geometry/interaction.h) per lane: p offset along n by the error bound, on the
+// side of w, then rounded away from the surface (next_float_up/down as integer steps).
+template <class D, class VF>
+void OffsetRayOrigin(D d, const VF p[3], const VF err[3], const VF n[3], const VF w[3], VF out[3]) {
+    const hn::RebindToSigned<D> di;
+    using VI = hn::Vec<decltype(di)>;
+    const VF zero = hn::Zero(d), inf = hn::Set(d, kInfinity), neg_zero = hn::Set(d, -0.f);
+    const VI ione = hn::Set(di, 1);
+    auto up = [&](VF v) {
+        const VF x = hn::IfThenElse(hn::Eq(v, zero), zero, v);  // -0 -> +0 (and +0 stays)
+        const VI bits = hn::BitCast(di, x);
+        const VF r = hn::IfThenElse(hn::Ge(x, zero), hn::BitCast(d, hn::Add(bits, ione)), hn::BitCast(d, hn::Sub(bits, ione)));
+        return hn::IfThenElse(hn::Eq(v, inf), v, r);
+    };
+    auto down = [&](VF v) {
+        const VF x = hn::IfThenElse(hn::Eq(v, zero), neg_zero, v);  // +0 -> -0
+        const VI bits = hn::BitCast(di, x);
+        const VF r = hn::IfThenElse(hn::Gt(x, zero), hn::BitCast(d, hn::Sub(bits, ione)), hn::BitCast(d, hn::Add(bits, ione)));
+        return hn::IfThenElse(hn::Eq(v, hn::Neg(inf)), v, r);
+    };
+    const VF dist = hn::Add(hn::Add(hn::Mul(hn::Abs(n[0]), err[0]), hn::Mul(hn::Abs(n[1]), err[1])), hn::Mul(hn::Abs(n[2]), err[2]));
+    const auto below = hn::Lt(hn::Add(hn::Add(hn::Mul(w[0], n[0]), hn::Mul(w[1], n[1])), hn::Mul(w[2], n[2])), zero);
+    for (int k = 0; k < 3; ++k) {
+        VF off = hn::Mul(dist, n[k]);
+        off = hn::IfThenElse(below, hn::Neg(off), off);
+        const VF po = hn::Add(p[k], off);
+        out[k] = hn::IfThenElse(hn::Gt(off, zero), up(po), hn::IfThenElse(hn::Lt(off, zero), down(po), po));
+    }
+}
+
 void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;
     using VF = hn::Vec<decltype(d)>;
-    using VI = hn::Vec<decltype(di)>;
     using MF = hn::Mask<decltype(d)>;
     const size_t lanes = hn::Lanes(d);
     const VF zero = hn::Zero(d), one = hn::Set(d, 1.f), two = hn::Set(d, 2.f);
     const VF inv_pi = hn::Set(d, kInvPi), quarter_pi = hn::Set(d, kPi / 4.f);
-    const VF inf = hn::Set(d, kInfinity), neg_zero = hn::Set(d, -0.f);
-    const VI ione = hn::Set(di, 1);
     auto sel = [](MF m, VF a, VF c) { return hn::IfThenElse(m, a, c); };
-    // next_float_up / next_float_down (core/math.h) per lane.
-    auto up = [&](VF v) {
-        const VF w = sel(hn::Eq(v, zero), zero, v);  // -0 -> +0 (and +0 stays)
-        const VI bits = hn::BitCast(di, w);
-        const VF r = hn::BitCast(d, sel(hn::Ge(w, zero), hn::BitCast(d, hn::Add(bits, ione)),
-                                        hn::BitCast(d, hn::Sub(bits, ione))));
-        return sel(hn::Eq(v, inf), v, r);
-    };
-    auto down = [&](VF v) {
-        const VF w = sel(hn::Eq(v, zero), neg_zero, v);  // +0 -> -0
-        const VI bits = hn::BitCast(di, w);
-        const VF r = hn::BitCast(d, sel(hn::Gt(w, zero), hn::BitCast(d, hn::Sub(bits, ione)),
-                                        hn::BitCast(d, hn::Add(bits, ione))));
-        return sel(hn::Eq(v, hn::Neg(inf)), v, r);
-    };
     for (size_t i = 0; i < n; i += lanes) {
         auto ld = [&](const float* a) { return hn::LoadU(d, a + i); };
         // DiffuseBsdf::sample: none when wo is below the surface.
@@ -82,17 +94,11 @@ void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
         VF w[3];
         for (int k = 0; k < 3; ++k)
             w[k] = hn::Add(hn::Add(hn::Mul(ld(b.s[k]), dx), hn::Mul(ld(b.t[k]), dy)), hn::Mul(ld(b.n[k]), z));
-        VF ng[3];
-        for (int k = 0; k < 3; ++k) ng[k] = ld(b.ng[k]);
-        const VF dist = hn::Add(hn::Add(hn::Mul(hn::Abs(ng[0]), ld(b.p_error[0])), hn::Mul(hn::Abs(ng[1]), ld(b.p_error[1]))),
-                                hn::Mul(hn::Abs(ng[2]), ld(b.p_error[2])));
-        const MF below = hn::Lt(hn::Add(hn::Add(hn::Mul(w[0], ng[0]), hn::Mul(w[1], ng[1])), hn::Mul(w[2], ng[2])), zero);
+        VF pv[3], ev[3], ng[3], o[3];
+        for (int k = 0; k < 3; ++k) pv[k] = ld(b.p[k]), ev[k] = ld(b.p_error[k]), ng[k] = ld(b.ng[k]);
+        OffsetRayOrigin(d, pv, ev, ng, w, o);
         for (int k = 0; k < 3; ++k) {
-            VF off = hn::Mul(dist, ng[k]);
-            off = sel(below, hn::Neg(off), off);
-            const VF po = hn::Add(ld(b.p[k]), off);
-            const VF o = sel(hn::Gt(off, zero), up(po), sel(hn::Lt(off, zero), down(po), po));
-            hn::StoreU(o, d, b.o[k] + i);
+            hn::StoreU(o[k], d, b.o[k] + i);
             hn::StoreU(w[k], d, b.d[k] + i);
         }
         // Russian roulette: q = min(max_component(beta) eta_scale, 0.95) as std::min and std::max.
@@ -109,6 +115,101 @@ void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
     }
 }
 
+void AreaLightStep(size_t n, const float* cdf, const float* tri, const float* radiance, size_t entries, bool mis,
+                   const AreaLightStepBatch& b) {
+    const hn::ScalableTag<float> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    using VF = hn::Vec<decltype(d)>;
+    using VI = hn::Vec<decltype(di)>;
+    using MF = hn::Mask<decltype(d)>;
+    const size_t lanes = hn::Lanes(d);
+    const VF zero = hn::Zero(d), one = hn::Set(d, 1.f), half_v = hn::Set(d, 2.f);
+    const VF inv_pi = hn::Set(d, kInvPi), gamma6 = hn::Set(d, gamma_bound(6));
+    auto sel = [](MF m, VF a, VF c) { return hn::IfThenElse(m, a, c); };
+    auto dot3 = [](const VF a[3], const VF c[3]) {
+        return hn::Add(hn::Add(hn::Mul(a[0], c[0]), hn::Mul(a[1], c[1])), hn::Mul(a[2], c[2]));
+    };
+    const VI last = hn::Set(di, int32_t(entries) - 1);
+    for (size_t i = 0; i < n; i += lanes) {
+        auto ld = [&](const float* a) { return hn::LoadU(d, a + i); };
+        // DiscreteDistribution::sample: the last CDF entry u is not below (cdf[0] = 0 is never
+        // compared); no zero-pmf entries (area_triangle_tables), so no stepping over them.
+        const VF ul = ld(b.u_l);
+        VI base = hn::Zero(di);
+        for (size_t m = entries + 1; m > 1;) {
+            const size_t h = m / 2;
+            const VI cand = hn::Add(base, hn::Set(di, int32_t(h)));
+            base = hn::IfThenElse(hn::RebindMask(di, hn::Lt(ul, hn::GatherIndex(d, cdf, cand))), base, cand);
+            m -= h;
+        }
+        const VI e = hn::Min(base, last);
+        const VI e14 = hn::Mul(e, hn::Set(di, 14)), e3 = hn::Mul(e, hn::Set(di, 3));
+        // square_to_uniform_triangle, interpolate_point (b0 = b.x, b1 = b.y, b2 = 1 - b.x - b.y).
+        const VF ux = ld(b.u[0]), uy = ld(b.u[1]);
+        const VF hx = hn::Div(ux, half_v), hy = hn::Div(uy, half_v);
+        const MF lower = hn::Lt(ux, uy);
+        const VF bx = sel(lower, hx, hn::Sub(ux, hy)), by = sel(lower, hn::Sub(uy, hx), hy);
+        const VF bz = hn::Sub(hn::Sub(one, bx), by);
+        VF lp[3], lerr[3], lng[3], P[3], dv[3];
+        for (int k = 0; k < 3; ++k) {
+            const VF a = hn::Mul(bx, hn::GatherIndex(d, tri + k, e14));
+            const VF c = hn::Mul(by, hn::GatherIndex(d, tri + 3 + k, e14));
+            const VF f = hn::Mul(bz, hn::GatherIndex(d, tri + 6 + k, e14));
+            lp[k] = hn::Add(hn::Add(a, c), f);
+            lerr[k] = hn::Mul(gamma6, hn::Add(hn::Add(hn::Abs(a), hn::Abs(c)), hn::Abs(f)));
+            lng[k] = hn::GatherIndex(d, tri + 9 + k, e14);
+            P[k] = ld(b.p[k]);
+            dv[k] = hn::Sub(lp[k], P[k]);
+        }
+        const VF dist2 = dot3(dv, dv);
+        MF ok = hn::Gt(dist2, zero);
+        const VF dist = hn::Sqrt(dist2);
+        VF wi[3];
+        for (int k = 0; k < 3; ++k) wi[k] = hn::Div(dv[k], dist);
+        const VF wn = dot3(wi, lng);
+        const VF cos_light = hn::Neg(wn);
+        ok = hn::And(ok, hn::Not(hn::Or(hn::Ge(wn, zero), hn::Eq(cos_light, zero))));
+        const VF pmf_area = hn::GatherIndex(d, tri + 12, e14);
+        const VF lpdf = hn::Div(hn::Mul(pmf_area, dist2), hn::Abs(cos_light));
+        ok = hn::And(ok, hn::And(hn::IsFinite(lpdf), hn::Gt(lpdf, zero)));
+        // The BSDF there: wi in the shading frame, then DiffuseBsdf::eval_pdf.
+        VF fs[3], ft[3], fn[3];
+        for (int k = 0; k < 3; ++k) fs[k] = ld(b.s[k]), ft[k] = ld(b.t[k]), fn[k] = ld(b.n[k]);
+        const VF wz = dot3(wi, fn);
+        ok = hn::And(ok, hn::And(hn::Gt(ld(b.wo_z), zero), hn::Gt(wz, zero)));
+        (void)fs, (void)ft;  // wi.x, wi.y: not needed by the diffuse BSDF
+        const VF fz = hn::Mul(inv_pi, wz);
+        const VF bpdf = hn::Mul(wz, inv_pi);
+        VF f[3];
+        for (int k = 0; k < 3; ++k) f[k] = hn::Mul(ld(b.albedo[k]), fz);
+        ok = hn::And(ok, hn::Not(hn::And(hn::And(hn::Eq(f[0], zero), hn::Eq(f[1], zero)), hn::Eq(f[2], zero))));
+        // power_heuristic(light pdf, bsdf pdf x 1) in MIS mode, else 1; the contribution
+        // beta f Le (1 w / pdf).
+        VF w = one;
+        if (mis) {
+            const VF a2 = hn::Mul(lpdf, lpdf), c2 = hn::Mul(hn::Mul(bpdf, one), hn::Mul(bpdf, one));
+            const VF sum = hn::Add(a2, c2);
+            w = sel(hn::IsInf(a2), one, sel(hn::Gt(sum, zero), hn::Div(a2, sum), zero));
+        }
+        const VF scale = hn::Div(hn::Mul(one, w), lpdf);
+        for (int k = 0; k < 3; ++k) {
+            const VF Le = hn::GatherIndex(d, radiance + k, e3);
+            hn::StoreU(hn::Mul(hn::Mul(hn::Mul(ld(b.beta[k]), f[k]), Le), scale), d, b.L[k] + i);
+        }
+        // spawn_ray_to(si, light point, its error, its normal).
+        VF err[3], ng[3], o[3], pt[3], back[3];
+        for (int k = 0; k < 3; ++k) err[k] = ld(b.p_error[k]), ng[k] = ld(b.ng[k]);
+        OffsetRayOrigin(d, P, err, ng, dv, o);
+        for (int k = 0; k < 3; ++k) back[k] = hn::Sub(o[k], lp[k]);
+        OffsetRayOrigin(d, lp, lerr, lng, back, pt);
+        for (int k = 0; k < 3; ++k) {
+            hn::StoreU(o[k], d, b.o[k] + i);
+            hn::StoreU(hn::Sub(pt[k], o[k]), d, b.d[k] + i);
+        }
+        hn::StoreU(hn::IfThenElseZero(hn::RebindMask(di, ok), hn::Set(di, 1)), di, b.shadow + i);
+    }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace candela
 HWY_AFTER_NAMESPACE();
@@ -117,8 +218,13 @@ HWY_AFTER_NAMESPACE();
 namespace candela {
 
 HWY_EXPORT(DiffuseStep);
+HWY_EXPORT(AreaLightStep);
 
 void diffuse_step(size_t n, const DiffuseStepBatch& b) { HWY_DYNAMIC_DISPATCH(DiffuseStep)(n, b); }
+void area_light_step(size_t n, const float* cdf, const float* tri, const float* radiance, size_t entries, bool mis,
+                     const AreaLightStepBatch& b) {
+    HWY_DYNAMIC_DISPATCH(AreaLightStep)(n, cdf, tri, radiance, entries, mis, b);
+}
 
 }  // namespace candela
 #endif  // HWY_ONCE

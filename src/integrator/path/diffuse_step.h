@@ -38,4 +38,33 @@ struct DiffuseStepBatch {
 constexpr size_t kDiffuseStepAlign = 16;
 void diffuse_step(size_t n, const DiffuseStepBatch& b);
 
+// The light sample of a bounce on a diffuse surface, with area lights that are emissive triangles
+// only (LightSet::area_triangle_tables): the light sample (LightSet::sample_li), the BSDF's value
+// and pdf there, the MIS weight against BSDF sampling (`mis`; else 1), the shadow ray
+// (spawn_ray_to) and what the sample adds when nothing is in the way, as Li computes them.
+struct AreaLightStepBatch {
+    // In: the light sample's numbers (u_l chooses the triangle, u picks the point), the surface
+    // point, its error and geometric normal, the shading frame, wo.z, the albedo, the throughput.
+    const float* u_l;
+    const float* u[2];
+    const float* p[3];
+    const float* p_error[3];
+    const float* ng[3];
+    const float* s[3];
+    const float* t[3];
+    const float* n[3];
+    const float* wo_z;
+    const float* albedo[3];
+    const float* beta[3];
+    // Out: whether there is a shadow ray (1/0), its origin and direction (tmax 1 - kShadowEpsilon),
+    // and the radiance it adds when unoccluded.
+    int32_t* shadow;
+    float* o[3];
+    float* d[3];
+    float* L[3];
+};
+// The tables: LightSet::AreaTriangleTables (light/area.h), passed as plain pointers.
+void area_light_step(size_t n, const float* cdf, const float* tri, const float* radiance, size_t entries, bool mis,
+                     const AreaLightStepBatch& b);
+
 }  // namespace candela

@@ -49,6 +49,9 @@ struct StagedScratch {
     std::vector<uint32_t> step_path;
     std::vector<float> sf[9], wo_z, albedo[3], u[2], u_rr, eta_scale, sp[3], serr[3], sng[3], beta[3], pdf, o[3], dir[3];
     std::vector<int32_t> rr, alive;
+    // The light samples' lanes (the same lanes).
+    std::vector<float> u_l, u_lp[2], so[3], sd[3], sL[3];
+    std::vector<int32_t> shadow;
 };
 
 // Runs the paths whose indices are in `live` (emptied on return) to their end. Diffuse-only scenes
@@ -68,10 +71,16 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
         for (int k = 0; k < 3; ++k) {
             for (auto* v : {&x.albedo[k], &x.sp[k], &x.serr[k], &x.sng[k], &x.beta[k], &x.o[k], &x.dir[k]}) v->resize(cap);
         }
-        for (auto* v : {&x.wo_z, &x.u[0], &x.u[1], &x.u_rr, &x.eta_scale, &x.pdf}) v->resize(cap);
+        for (auto* v : {&x.wo_z, &x.u[0], &x.u[1], &x.u_rr, &x.eta_scale, &x.pdf, &x.u_l, &x.u_lp[0], &x.u_lp[1]})
+            v->resize(cap);
+        for (int k = 0; k < 3; ++k) x.so[k].resize(cap), x.sd[k].resize(cap), x.sL[k].resize(cap);
+        x.shadow.resize(cap);
         x.rr.resize(cap);
         x.alive.resize(cap);
     }
+    // Light samples in lanes: area lights that are emissive triangles only, in MIS or light mode.
+    LightSet::AreaTriangleTables tables;
+    const bool lanes_nee = mode != SamplingMode::Bsdf && sc.lights.area_triangle_tables(tables);
     x.smooth.resize(sc.shapes.size());
     for (size_t s = 0; s < sc.shapes.size(); ++s) x.smooth[s] = sc.shapes[s].smooth ? 1 : 0;
     while (!live.empty()) {
@@ -151,7 +160,14 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
             }
             if (st.max_depth >= 0 && p.depth >= st.max_depth) continue;
             shade<true>(sc, hit, si, wo_world, sh);
-            if (mode != SamplingMode::Bsdf && have_lights && sh.has_smooth_component()) {
+            const size_t q = ns++;  // every shaded path (diffuse: one smooth lobe) takes a lane
+            if (lanes_nee) {
+                // The light sample in lanes (stage 2c): its numbers now, in Li's order.
+                x.u_l[q] = p.sampler.next_1d();
+                const vec2 up = p.sampler.next_2d();
+                x.u_lp[0][q] = up.x;
+                x.u_lp[1][q] = up.y;
+            } else if (mode != SamplingMode::Bsdf && have_lights && sh.has_smooth_component()) {
                 const float ul = p.sampler.next_1d();
                 const vec2 up = p.sampler.next_2d();
                 LightSample ls;
@@ -180,7 +196,6 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
             const bool rr = p.depth + 1 >= st.rr_depth;
             const float u_rr = rr ? p.sampler.next_1d() : 0.f;
             const DiffuseBsdf& bsdf = std::get<DiffuseBsdf>(*sh.bsdf);
-            const size_t q = ns++;
             x.step_path[q] = i;
             for (int k = 0; k < 3; ++k) {
                 x.sf[k][q] = sh.frame.s[k];
@@ -199,18 +214,49 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
             x.rr[q] = rr ? 1 : 0;
             x.eta_scale[q] = p.eta_scale;
         }
-        // Stage 2c: the diffuse step in SIMD lanes (BSDF sample, throughput, next ray, roulette),
-        // then the paths that go on, in path order.
+        // Stage 2c: the light samples in SIMD lanes (when the lights allow), then the diffuse step
+        // (BSDF sample, throughput, next ray, roulette), then the paths that go on, in path order.
         if (ns > 0) {
             // Padding lanes up to the SIMD batch's multiple: finite values, results ignored.
             const size_t padded_ns = (ns + kDiffuseStepAlign - 1) / kDiffuseStepAlign * kDiffuseStepAlign;
             for (size_t q = ns; q < padded_ns; ++q) {
+                x.u_l[q] = 0.5f;
+                x.u_lp[0][q] = x.u_lp[1][q] = 0.25f;
                 for (auto& v : x.sf) v[q] = 0.f;
                 for (int k = 0; k < 3; ++k) x.albedo[k][q] = x.sp[k][q] = x.serr[k][q] = x.sng[k][q] = x.beta[k][q] = 0.f;
                 x.wo_z[q] = x.u_rr[q] = 0.f;
                 x.u[0][q] = x.u[1][q] = 0.5f;
                 x.rr[q] = 0;
                 x.eta_scale[q] = 1.f;
+            }
+            if (lanes_nee) {
+                area_light_step(ns, tables.cdf, tables.tri, tables.radiance, tables.entries, mode == SamplingMode::Mis,
+                                AreaLightStepBatch{x.u_l.data(),
+                                                   {x.u_lp[0].data(), x.u_lp[1].data()},
+                                                   {x.sp[0].data(), x.sp[1].data(), x.sp[2].data()},
+                                                   {x.serr[0].data(), x.serr[1].data(), x.serr[2].data()},
+                                                   {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
+                                                   {x.sf[0].data(), x.sf[1].data(), x.sf[2].data()},
+                                                   {x.sf[3].data(), x.sf[4].data(), x.sf[5].data()},
+                                                   {x.sf[6].data(), x.sf[7].data(), x.sf[8].data()},
+                                                   x.wo_z.data(),
+                                                   {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
+                                                   {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
+                                                   x.shadow.data(),
+                                                   {x.so[0].data(), x.so[1].data(), x.so[2].data()},
+                                                   {x.sd[0].data(), x.sd[1].data(), x.sd[2].data()},
+                                                   {x.sL[0].data(), x.sL[1].data(), x.sL[2].data()}});
+                for (size_t j = 0; j < ns; ++j) {
+                    if (!x.shadow[j]) continue;
+                    StagedPath<S>& p = paths[x.step_path[j]];
+                    p.shadow = Ray();
+                    p.shadow.o = vec3(x.so[0][j], x.so[1][j], x.so[2][j]);
+                    p.shadow.d = vec3(x.sd[0][j], x.sd[1][j], x.sd[2][j]);
+                    p.shadow.tmax = 1.f - kShadowEpsilon;
+                    p.shadow_L = vec3(x.sL[0][j], x.sL[1][j], x.sL[2][j]);
+                    ++stats.rays;
+                    x.shadowed.push_back(x.step_path[j]);
+                }
             }
             diffuse_step(ns, DiffuseStepBatch{{x.sf[0].data(), x.sf[1].data(), x.sf[2].data()},
                                               {x.sf[3].data(), x.sf[4].data(), x.sf[5].data()},
