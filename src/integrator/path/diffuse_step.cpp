@@ -20,7 +20,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 // offset_ray_origin (geometry/interaction.h) per lane: p offset along n by the error bound, on the
 // side of w, then rounded away from the surface (next_float_up/down as integer steps).
 template <class D, class VF>
-void OffsetRayOrigin(D d, const VF p[3], const VF err[3], const VF n[3], const VF w[3], VF out[3]) {
+HWY_INLINE void OffsetRayOrigin(D d, const VF p[3], const VF err[3], const VF n[3], const VF w[3], VF out[3]) {
     const hn::RebindToSigned<D> di;
     using VI = hn::Vec<decltype(di)>;
     const VF zero = hn::Zero(d), inf = hn::Set(d, kInfinity), neg_zero = hn::Set(d, -0.f);
