@@ -1,20 +1,24 @@
 #pragma once
-// The path tracer in stages over a batch of paths: the first step towards a SIMD wavefront
-// (issue 18). WORK IN PROGRESS on the `wavefront` branch; docs/wavefront-plan.md there has the plan.
+// The path tracer in stages over a batch of paths: the start of the SIMD wavefront of issue 18
+// (docs/wavefront.md has the plan and the measurements).
 //
 // A tile's paths (its pixels times the pass's samples) advance together, one bounce per round:
-//   1. closest hit of every live path;
-//   2. per path, everything up to its next ray: emission, the light sample and its shadow ray,
-//      the BSDF sample and Russian roulette (the shadow ray's outcome changes no sampler draw and
-//      no throughput, so the path can go on before it is known);
-//   3. the shadow rays of the round, whose contribution (computed in 2 as if unoccluded) is added
-//      to the path's radiance when nothing is in the way.
+//   1. the closest hit of every live path (traversal stays per ray: it is at Embree's speed);
+//   2. hit reconstruction of the round's triangle hits in SIMD lanes (hit_soa.h); then per path,
+//      emission and shading, and the numbers of its light sample, BSDF sample and roulette, drawn
+//      in Li's order;
+//   3. in SIMD lanes, the light samples when the lights are emissive triangles (the shadow ray
+//      and its contribution, computed as if unoccluded) and the diffuse step: BSDF sample,
+//      throughput, next ray, roulette (diffuse_step.h);
+//   4. the round's shadow rays, in path order; each adds its contribution when unoccluded (the
+//      shadow ray's outcome changes no sampler draw and no throughput, so the path went on before).
 // Each path makes the operations of PathIntegrator::Li<S, true> (path_impl.h) in the same order,
-// and its radiance is added to the film in the scalar loop's order: the image is the same bit for
-// bit. The stages run path by path for now; SoA state and SIMD stages are the next steps.
+// and the film gets the samples in the scalar loop's order: the image is the same bit for bit
+// (tests/test_staged.cpp compares the films on every SIMD target).
 //
-// Scope: the diffuse-only instantiation (no masks) without textures, an unweighted film (box
-// filter) without adaptive sampling, AOVs or alpha. render_pass_for falls back to the per-path loop otherwise.
+// Scope (staged_pass_applies): the diffuse-only instantiation (no masks) without textures, the
+// independent sampler, an unweighted film (box filter) without adaptive sampling, AOVs or alpha.
+// The path pass uses the per-path loop otherwise, and with CANDELA_STAGED=0.
 #include <vector>
 #include "integrator/path.h"
 #include "integrator/path/diffuse_step.h"
@@ -114,6 +118,7 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
         x.batched.assign(m, 0);
         x.shape.resize(padded);
         for (auto& v : x.f) v.resize(padded);
+        size_t batched = 0;
         for (size_t j = 0; j < m; ++j) {
             const Hit& h = x.hits[j];
             if (h.kind != PrimKind::Triangle || h.instance != ~0u) continue;
@@ -121,8 +126,10 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
             x.prim[j] = h.prim;
             x.b1[j] = h.b1;
             x.b2[j] = h.b2;
+            ++batched;
         }
-        if (m > 0)
+        // (A scene of analytic shapes only has an empty mesh: nothing to gather from.)
+        if (batched > 0)
             reconstruct_triangle_hits(sc.mesh, x.smooth.data(), m, HitBatch{x.prim.data(), x.b1.data(), x.b2.data()},
                                       SurfaceBatch{{x.f[0].data(), x.f[1].data(), x.f[2].data()},
                                                    {x.f[3].data(), x.f[4].data(), x.f[5].data()},
