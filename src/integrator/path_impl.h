@@ -43,6 +43,23 @@ inline void add_infinite(const LightSet& lights, vec3 w, vec3 beta, bool after_d
     });
 }
 
+// The emission a ray reaches at `hit` (seen from wo_world), weighted as light sampling requires:
+// fully after a delta bounce or in BSDF mode, by the power heuristic against the light's sampling
+// density in MIS mode, not at all in light mode (light sampling counted it). Shared by Li and the
+// staged loop (path/wavefront.h), which must add the same bits.
+inline void add_emission(const Scene& sc, const Hit& hit, const SurfaceInteraction& si, vec3 wo_world, vec3 beta,
+                         bool after_delta, SamplingMode mode, vec3 prev_p, float prev_pdf, vec3& L) {
+    if (sc.lights.emitter_of(hit) < 0) return;
+    const vec3 Le = sc.lights.emitted(si, wo_world);
+    if (is_black(Le)) return;
+    if (after_delta || mode == SamplingMode::Bsdf) {
+        L += beta * Le;
+    } else if (mode == SamplingMode::Mis) {
+        const float light_pdf = sc.lights.pdf_li(prev_p, si);
+        L += beta * Le * power_heuristic(prev_pdf, light_pdf);
+    }
+}
+
 template <class S, bool DiffuseOnly>
 vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const Scene& sc = scene_;
@@ -76,17 +93,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         vec3 wo_world = -glm::normalize(ray.d);
 
         // Emission reached by this ray.
-        if (sc.lights.emitter_of(hit) >= 0) {
-            vec3 Le = sc.lights.emitted(si, wo_world);
-            if (!is_black(Le)) {
-                if (after_delta || mode == SamplingMode::Bsdf) {
-                    L += beta * Le;
-                } else if (mode == SamplingMode::Mis) {
-                    float light_pdf = sc.lights.pdf_li(prev_p, si);
-                    L += beta * Le * power_heuristic(prev_pdf, light_pdf);
-                }  // Light mode: this path was already counted by light sampling.
-            }
-        }
+        add_emission(sc, hit, si, wo_world, beta, after_delta, mode, prev_p, prev_pdf, L);
         if constexpr (!DiffuseOnly) {
             if (masks_) {  // pass straight through with probability 1 - opacity (not a vertex)
                 const Material& m = sc.materials[sc.shapes[si.shape].material];

@@ -154,17 +154,7 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
                 si = sc.interaction(hit);
             }
             const vec3 wo_world = -glm::normalize(p.ray.d);
-            if (sc.lights.emitter_of(hit) >= 0) {
-                const vec3 Le = sc.lights.emitted(si, wo_world);
-                if (!is_black(Le)) {
-                    if (p.after_delta || mode == SamplingMode::Bsdf) {
-                        p.L += p.beta * Le;
-                    } else if (mode == SamplingMode::Mis) {
-                        const float light_pdf = sc.lights.pdf_li(p.prev_p, si);
-                        p.L += p.beta * Le * power_heuristic(p.prev_pdf, light_pdf);
-                    }
-                }
-            }
+            add_emission(sc, hit, si, wo_world, p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf, p.L);
             if (st.max_depth >= 0 && p.depth >= st.max_depth) continue;
             shade<true>(sc, hit, si, wo_world, sh);
             const size_t q = ns++;  // every shaded path (diffuse: one smooth lobe) takes a lane
