@@ -1,4 +1,5 @@
 #pragma once
+#include <climits>
 #include <memory>
 #include <vector>
 #include "geometry/analytic.h"
@@ -73,6 +74,7 @@ public:
     bool area_triangle_tables(AreaTriangleTables& out) const {
         if (tris_.empty() || !alights_.empty() || !lights_.empty() || !mesh_->normals.empty() || has_textured_emitter())
             return false;
+        if (dist_.size() > size_t(INT32_MAX) / 14) return false;  // the lanes gather with 32-bit indices
         for (size_t i = 0; i < dist_.size(); ++i)
             if (!(dist_.pmf(i) > 0.f)) return false;
         static_assert(sizeof(EmissiveTriangle) == 14 * sizeof(float), "EmissiveTriangle: 14 floats, no padding");

@@ -19,6 +19,7 @@
 // Scope (staged_pass_applies): the diffuse-only instantiation (no masks) without textures, the
 // independent sampler, an unweighted film (box filter) without adaptive sampling, AOVs or alpha.
 // The path pass uses the per-path loop otherwise, and with CANDELA_STAGED=0.
+#include <climits>
 #include <vector>
 #include "integrator/path.h"
 #include "integrator/path/diffuse_step.h"
@@ -299,6 +300,9 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
 // Whether render_tiles_staged can render this pass (see the scope above).
 inline bool staged_pass_applies(const Scene& scene, const Film& film) {
     if (!scene_is_diffuse_only(scene) || scene.lights.has_textured_emitter()) return false;
+    // The lanes gather with 32-bit indices (3 floats per vertex and per triangle).
+    constexpr size_t kMaxGathered = size_t(INT32_MAX) / 3;
+    if (scene.mesh.positions.size() > kMaxGathered || scene.mesh.triangles.size() > kMaxGathered) return false;
     for (const Material& m : scene.materials)
         if (m.textured()) return false;
     return !film.weighted() && !film.adaptive() && film.aov_channels() == 0 && !film.has_alpha();
