@@ -172,12 +172,11 @@ void AreaLightStep(size_t n, const float* cdf, const float* tri, const float* ra
         const VF pmf_area = hn::GatherIndex(d, tri + 12, e14);
         const VF lpdf = hn::Div(hn::Mul(pmf_area, dist2), hn::Abs(cos_light));
         ok = hn::And(ok, hn::And(hn::IsFinite(lpdf), hn::Gt(lpdf, zero)));
-        // The BSDF there: wi in the shading frame, then DiffuseBsdf::eval_pdf.
-        VF fs[3], ft[3], fn[3];
-        for (int k = 0; k < 3; ++k) fs[k] = ld(b.s[k]), ft[k] = ld(b.t[k]), fn[k] = ld(b.n[k]);
-        const VF wz = dot3(wi, fn);
+        // The BSDF there: DiffuseBsdf::eval_pdf.
+        VF fn[3];
+        for (int k = 0; k < 3; ++k) fn[k] = ld(b.n[k]);
+        const VF wz = dot3(wi, fn);  // to_local(wi).z; its x and y do not enter the diffuse BSDF
         ok = hn::And(ok, hn::And(hn::Gt(ld(b.wo_z), zero), hn::Gt(wz, zero)));
-        (void)fs, (void)ft;  // wi.x, wi.y: not needed by the diffuse BSDF
         const VF fz = hn::Mul(inv_pi, wz);
         const VF bpdf = hn::Mul(wz, inv_pi);
         VF f[3];

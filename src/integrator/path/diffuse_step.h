@@ -44,15 +44,13 @@ void diffuse_step(size_t n, const DiffuseStepBatch& b);
 // (spawn_ray_to) and what the sample adds when nothing is in the way, as Li computes them.
 struct AreaLightStepBatch {
     // In: the light sample's numbers (u_l chooses the triangle, u picks the point), the surface
-    // point, its error and geometric normal, the shading frame, wo.z, the albedo, the throughput.
+    // point, its error and geometric normal, the shading normal, wo.z, the albedo, the throughput.
     const float* u_l;
     const float* u[2];
     const float* p[3];
     const float* p_error[3];
     const float* ng[3];
-    const float* s[3];
-    const float* t[3];
-    const float* n[3];
+    const float* n[3];  // the shading normal: the diffuse BSDF needs only cos theta of wi
     const float* wo_z;
     const float* albedo[3];
     const float* beta[3];

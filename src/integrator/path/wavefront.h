@@ -234,8 +234,6 @@ void trace_staged(const Scene& sc, std::vector<StagedPath<S>>& paths, std::vecto
                                                    {x.sp[0].data(), x.sp[1].data(), x.sp[2].data()},
                                                    {x.serr[0].data(), x.serr[1].data(), x.serr[2].data()},
                                                    {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
-                                                   {x.sf[0].data(), x.sf[1].data(), x.sf[2].data()},
-                                                   {x.sf[3].data(), x.sf[4].data(), x.sf[5].data()},
                                                    {x.sf[6].data(), x.sf[7].data(), x.sf[8].data()},
                                                    x.wo_z.data(),
                                                    {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
