@@ -6,6 +6,7 @@
 #include <hwy/targets.h>
 #include "integrator/path/hit_soa.h"
 #include "integrator/path/wavefront.h"
+#include "scene/cornell.h"
 #include "scene/loaders.h"
 #include "integrator/sampled_pass.h"
 #include "render/launch.h"
@@ -71,6 +72,26 @@ TEST(Staged, HiddenEmittersAndOneThread) {
     p.settings.integrator.hide_emitters = true;
     std::shared_ptr<const Scene> s = box->with_params(p);
     expect_same_films(*s, 20, 20, 2, 1, 20 * 20 / 2, "hide_emitters");
+}
+
+TEST(Staged, BackFacesOfOneAndTwoSidedMaterials) {
+    // The box's walls and blocks wound the other way (their normals point out of the box): the
+    // paths inside see their backs. White and red are two-sided, so shading turns the frame to
+    // the path's side; green is one-sided and black from the back.
+    SceneDescription d = make_cornell_box();
+    d.materials[0].two_sided = d.materials[1].two_sided = true;
+    for (size_t t = 0; t < d.mesh.triangles.size(); ++t)
+        if (d.shapes[d.mesh.tri_shape[t]].emitter < 0) std::swap(d.mesh.triangles[t].y, d.mesh.triangles[t].z);
+    d.settings.width = d.settings.height = 24;
+    auto sc = build_scene(std::move(d));
+    for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Light, SamplingMode::Bsdf}) {
+        SceneParams p = sc->params();
+        p.settings.sampling = mode;
+        p.settings.max_depth = -1;
+        auto s = sc->with_params(p);
+        const int min_lit = mode == SamplingMode::Bsdf ? 10 : 24 * 24 / 2;
+        expect_same_films(*s, 24, 24, 3, 2, min_lit, ("back faces, mode " + std::to_string(int(mode))).c_str());
+    }
 }
 
 

@@ -47,6 +47,39 @@ HWY_INLINE void OffsetRayOrigin(D d, const VF p[3], const VF err[3], const VF n[
     }
 }
 
+void ShadeDiffuse(size_t n, const float* albedo, const int32_t* two_sided, const ShadeDiffuseBatch& b) {
+    const hn::ScalableTag<float> d;
+    const hn::RebindToSigned<decltype(d)> di;
+    using VF = hn::Vec<decltype(d)>;
+    const size_t lanes = hn::Lanes(d);
+    const VF one = hn::Set(d, 1.f), zero = hn::Zero(d);
+    const hn::Vec<decltype(di)> three = hn::Set(di, 3);
+    auto dot3 = [](const VF a[3], const VF c[3]) {
+        return hn::Add(hn::Add(hn::Mul(a[0], c[0]), hn::Mul(a[1], c[1])), hn::Mul(a[2], c[2]));
+    };
+    for (size_t i = 0; i < n; i += lanes) {
+        auto ld = [&](const float* a) { return hn::LoadU(d, a + i); };
+        // wo = -normalize(d), as glm: d * (1 / sqrt(dot(d, d))).
+        VF rd[3], ns[3], wo[3];
+        for (int k = 0; k < 3; ++k) rd[k] = ld(b.ray_d[k]), ns[k] = ld(b.ns[k]);
+        const VF inv = hn::Div(one, hn::Sqrt(dot3(rd, rd)));
+        for (int k = 0; k < 3; ++k) wo[k] = hn::Neg(hn::Mul(rd[k], inv));
+        const hn::Vec<decltype(di)> shape = hn::BitCast(di, hn::LoadU(hn::RebindToUnsigned<decltype(d)>(), b.shape + i));
+        const auto ts = hn::RebindMask(d, hn::Ne(hn::GatherIndex(di, two_sided, shape), hn::Zero(di)));
+        const auto flipped = hn::And(ts, hn::Lt(dot3(wo, ns), zero));
+        VF nv[3];
+        for (int k = 0; k < 3; ++k) {
+            nv[k] = hn::IfThenElse(flipped, hn::Neg(ns[k]), ns[k]);
+            hn::StoreU(nv[k], d, b.n[k] + i);
+            const VF g = ld(b.ng[k]);
+            hn::StoreU(hn::IfThenElse(flipped, hn::Neg(g), g), d, b.ng_out[k] + i);
+        }
+        hn::StoreU(dot3(wo, nv), d, b.wo_z + i);  // Frame(n).to_local(wo).z
+        const auto s3 = hn::Mul(shape, three);
+        for (int k = 0; k < 3; ++k) hn::StoreU(hn::GatherIndex(d, albedo + k, s3), d, b.albedo[k] + i);
+    }
+}
+
 void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
     const hn::ScalableTag<float> d;
     const hn::RebindToSigned<decltype(d)> di;
@@ -90,10 +123,17 @@ void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
         for (int k = 0; k < 3; ++k)
             beta[k] = hn::Mul(hn::LoadU(d, b.beta[k] + i), hn::Div(hn::Mul(ld(b.albedo[k]), fz), pdf));
         ok = hn::And(ok, hn::Not(hn::And(hn::And(hn::Eq(beta[0], zero), hn::Eq(beta[1], zero)), hn::Eq(beta[2], zero))));
-        // The next ray: to_world, then offset_ray_origin.
+        // The next ray: Frame(n).to_world (Duff et al.'s basis, as frame.h builds it), then
+        // offset_ray_origin.
+        const VF nv[3] = {ld(b.n[0]), ld(b.n[1]), ld(b.n[2])};
+        const VF sign = hn::CopySign(one, nv[2]);
+        const VF fa = hn::Div(hn::Set(d, -1.f), hn::Add(sign, nv[2]));
+        const VF fb = hn::Mul(hn::Mul(nv[0], nv[1]), fa);
+        const VF s[3] = {hn::Add(one, hn::Mul(hn::Mul(hn::Mul(sign, nv[0]), nv[0]), fa)), hn::Mul(sign, fb),
+                         hn::Mul(hn::Neg(sign), nv[0])};
+        const VF t[3] = {fb, hn::Add(sign, hn::Mul(hn::Mul(nv[1], nv[1]), fa)), hn::Neg(nv[1])};
         VF w[3];
-        for (int k = 0; k < 3; ++k)
-            w[k] = hn::Add(hn::Add(hn::Mul(ld(b.s[k]), dx), hn::Mul(ld(b.t[k]), dy)), hn::Mul(ld(b.n[k]), z));
+        for (int k = 0; k < 3; ++k) w[k] = hn::Add(hn::Add(hn::Mul(s[k], dx), hn::Mul(t[k], dy)), hn::Mul(nv[k], z));
         VF pv[3], ev[3], ng[3], o[3];
         for (int k = 0; k < 3; ++k) pv[k] = ld(b.p[k]), ev[k] = ld(b.p_error[k]), ng[k] = ld(b.ng[k]);
         OffsetRayOrigin(d, pv, ev, ng, w, o);
@@ -107,9 +147,11 @@ void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
         const VF qa = hn::Mul(mx, ld(b.eta_scale));
         const VF c95 = hn::Set(d, 0.95f);
         const VF q = sel(hn::Lt(c95, qa), c95, qa);
-        const MF rr = hn::RebindMask(d, hn::Ne(hn::LoadU(di, b.rr + i), hn::Zero(di)));
-        ok = hn::And(ok, hn::Not(hn::And(rr, hn::Ge(ld(b.u_rr), q))));
-        for (int k = 0; k < 3; ++k) hn::StoreU(sel(rr, hn::Div(beta[k], q), beta[k]), d, b.beta[k] + i);
+        if (b.rr) {
+            ok = hn::And(ok, hn::Not(hn::Ge(ld(b.u_rr), q)));
+            for (int k = 0; k < 3; ++k) beta[k] = hn::Div(beta[k], q);
+        }
+        for (int k = 0; k < 3; ++k) hn::StoreU(beta[k], d, b.beta[k] + i);
         hn::StoreU(pdf, d, b.pdf + i);
         hn::StoreU(hn::IfThenElseZero(hn::RebindMask(di, ok), hn::Set(di, 1)), di, b.alive + i);
     }
@@ -216,9 +258,13 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace candela {
 
+HWY_EXPORT(ShadeDiffuse);
 HWY_EXPORT(DiffuseStep);
 HWY_EXPORT(AreaLightStep);
 
+void shade_diffuse(size_t n, const float* albedo, const int32_t* two_sided, const ShadeDiffuseBatch& b) {
+    HWY_DYNAMIC_DISPATCH(ShadeDiffuse)(n, albedo, two_sided, b);
+}
 void diffuse_step(size_t n, const DiffuseStepBatch& b) { HWY_DYNAMIC_DISPATCH(DiffuseStep)(n, b); }
 void area_light_step(size_t n, const float* cdf, const float* tri, const float* radiance, size_t entries, bool mis,
                      const AreaLightStepBatch& b) {

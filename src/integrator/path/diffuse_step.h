@@ -1,25 +1,41 @@
 #pragma once
-// The end of a bounce on a diffuse surface for a batch of paths in SIMD lanes (wavefront branch,
-// work in progress): the BSDF sample (cosine hemisphere), the throughput update, the next ray
-// (spawn_ray) and Russian roulette. Lane i makes the float operations of the scalar loop
-// (PathIntegrator::Li with DiffuseBsdf::sample, Frame::to_world, offset_ray_origin, the roulette)
-// in the same order, so every result is the same bit for bit.
+// A bounce on a diffuse surface for a batch of paths in SIMD lanes (the staged loop, wavefront.h):
+// the shading, the light sample (area_light_step), the BSDF sample (cosine hemisphere), the
+// throughput update, the next ray (spawn_ray) and Russian roulette. Lane i makes the float
+// operations of the scalar loop (PathIntegrator::Li with shade, DiffuseBsdf::sample, Frame,
+// offset_ray_origin, the roulette) in the same order, so every result is the same bit for bit.
 #include <cstddef>
 #include <cstdint>
 
 namespace candela {
 
+// The shading of a hit on a diffuse, untextured material (shade() in integrator/shading.h): wo
+// from the ray's direction, the frame's normal turned to wo's side for a two-sided material (and
+// the geometric normal with it), wo.z in that frame and the albedo.
+struct ShadeDiffuseBatch {
+    // In: the ray's direction (any length), the hit's shading and geometric normals and its shape.
+    const float* ray_d[3];
+    const float* ns[3];
+    const float* ng[3];
+    const uint32_t* shape;
+    // Out: the frame's normal, the geometric normal turned with it, wo.z and the albedo.
+    float* n[3];
+    float* ng_out[3];
+    float* wo_z;
+    float* albedo[3];
+};
+// Per shape: `albedo` (3 floats) of its material and `two_sided` (1/0).
+void shade_diffuse(size_t n, const float* albedo, const int32_t* two_sided, const ShadeDiffuseBatch& b);
+
 struct DiffuseStepBatch {
-    // In: the shading frame (s, t, n), wo.z, the albedo, the BSDF sample's u2, the roulette's
-    // number and whether roulette applies (1/0), the surface point, its error and geometric normal.
-    const float* s[3];
-    const float* t[3];
+    // In: the shading frame's normal (the frame is Frame(n), frame.h), wo.z, the albedo, the BSDF
+    // sample's u2, the roulette's number, the surface point, its error and geometric normal.
     const float* n[3];
     const float* wo_z;
     const float* albedo[3];
     const float* u[2];
     const float* u_rr;
-    const int32_t* rr;
+    bool rr;  // whether roulette applies (the same for every lane: one depth per round)
     const float* eta_scale;
     const float* p[3];
     const float* p_error[3];
