@@ -94,6 +94,44 @@ TEST(Staged, BackFacesOfOneAndTwoSidedMaterials) {
     }
 }
 
+TEST(Staged, OtherMaterialsPerPathInTheSameRounds) {
+    // Glossy, rough, specular, layered and textured materials (their bounces made per path in the
+    // rounds), beside untextured diffuse ones in lanes; lights that are triangles, spheres, a
+    // point, an environment map and a constant.
+    const std::string src = CANDELA_SOURCE_DIR, shared = std::string(CANDELA_SHARED_DIR) + "/scenes-public/";
+    struct Case {
+        std::string file;
+        int lit_mis, lit_bsdf;  // pixels that must be lit (-1: mode not tried: a point light only)
+    };
+    const Case cases[] = {{src + "/scenes/cornell-materials/glossy-glass.xml", 24 * 20 / 2, 5},
+                          {src + "/scenes/cornell-materials/mirror-glass.xml", 24 * 20 / 2, 5},
+                          {src + "/scenes/cornell-materials/rough.xml", 24 * 20 / 2, 5},
+                          {shared + "tutorials_cbox/cbox.xml", 24 * 20 / 2, 5},
+                          {shared + "bitterli_veach_mis/scene.xml", 24 * 20 / 2, 5},
+                          {shared + "mdata_matpreview/matpreview.xml", 24 * 20 / 2, 24 * 20 / 2},
+                          {shared + "mdata_test_orthographic/test_orthographic_path.xml", 24 * 20 / 2, 24 * 20 / 2},
+                          {shared + "blender_export_test1/test1.xml", 20, -1}};
+    int textured = 0;
+    for (const Case& c : cases) {
+        auto sc = build_scene(load_scene(c.file));
+        bool plain_diffuse_only = true;
+        for (const Material& m : sc->materials) {
+            plain_diffuse_only = plain_diffuse_only && m.plain() && !m.textured() && std::holds_alternative<DiffuseBsdf>(m.bsdf);
+            textured += m.textured();
+        }
+        EXPECT_FALSE(plain_diffuse_only) << c.file << ": some hits are shaded per path";
+        for (SamplingMode mode : {SamplingMode::Mis, SamplingMode::Bsdf}) {
+            const int lit = mode == SamplingMode::Mis ? c.lit_mis : c.lit_bsdf;
+            if (lit < 0) continue;
+            SceneParams p = sc->params();
+            p.settings.sampling = mode;
+            p.settings.max_depth = 7;
+            auto s = sc->with_params(p);
+            expect_same_films(*s, 24, 20, 2, 2, lit, (c.file + ", mode " + std::to_string(int(mode))).c_str());
+        }
+    }
+    EXPECT_GE(textured, 2) << "textured materials among the cases";
+}
 
 namespace {
 

@@ -5,20 +5,21 @@
 // A tile's paths (its pixels times the pass's samples) advance together, one bounce per round:
 //   1. the closest hit of every live path (traversal stays per ray: it is at Embree's speed);
 //   2. hit reconstruction of the round's triangle hits in SIMD lanes (hit_soa.h); then per path,
-//      emission and shading, and the numbers of its light sample, BSDF sample and roulette, drawn
-//      in Li's order;
-//   3. in SIMD lanes, the light samples when the lights are emissive triangles (the shadow ray
-//      and its contribution, computed as if unoccluded) and the diffuse step: BSDF sample,
-//      throughput, next ray, roulette (diffuse_step.h);
-//   4. the round's shadow rays, in path order; each adds its contribution when unoccluded (the
-//      shadow ray's outcome changes no sampler draw and no throughput, so the path went on before).
-// Each path makes the operations of PathIntegrator::Li<S, true> (path_impl.h) in the same order,
-// and the film gets the samples in the scalar loop's order: the image is the same bit for bit
+//      emission and the numbers of this bounce, drawn in Li's order. A hit on a material other
+//      than plain, untextured diffuse makes its whole bounce here, per path, as Li does;
+//   3. in SIMD lanes, for the diffuse hits: the shading (frame, wo, albedo), the light samples when
+//      the lights are emissive triangles (the shadow ray and its contribution, computed as if
+//      unoccluded; per path otherwise) and the diffuse step: BSDF sample, throughput, next ray,
+//      roulette (diffuse_step.h);
+//   4. the round's shadow rays; each adds its contribution when unoccluded (the shadow ray's
+//      outcome changes no sampler draw and no throughput, so the path went on before).
+// Each path makes the operations of PathIntegrator::Li (path_impl.h) in the same order, and the
+// film gets the samples in the scalar loop's order: the image is the same bit for bit
 // (tests/test_staged.cpp compares the films on every SIMD target).
 //
-// Scope (staged_pass_applies): the diffuse-only instantiation (no masks) without textures, the
-// independent sampler, an unweighted film (box filter) without adaptive sampling, AOVs or alpha.
-// The path pass uses the per-path loop otherwise, and with CANDELA_STAGED=0.
+// Scope (staged_pass_applies): scenes without masks or textured emitters, the independent
+// sampler, an unweighted film (box filter) without adaptive sampling, AOVs or alpha. The path
+// pass uses the per-path loop otherwise, and with CANDELA_STAGED=0.
 #include <climits>
 #include <vector>
 #include "integrator/path.h"
@@ -43,7 +44,8 @@ struct StagedPath {
 // What the stages look up per shape, and the light tables: built once per pass.
 struct StagedTables {
     std::vector<int32_t> smooth;     // Shape::smooth (1/0)
-    std::vector<float> albedo;       // the diffuse albedo of its material (3 floats)
+    std::vector<uint8_t> lane;       // its material is plain, diffuse and untextured: shaded in lanes
+    std::vector<float> albedo;       // the diffuse albedo of such a material (3 floats; else 0)
     std::vector<int32_t> two_sided;  // its material is two-sided (1/0)
     LightSet::AreaTriangleTables lights;
     bool lanes_nee = false;          // light samples in lanes: every light an emissive triangle
@@ -51,8 +53,11 @@ struct StagedTables {
     explicit StagedTables(const Scene& sc) {
         for (const Shape& shape : sc.shapes) {
             const Material& m = sc.materials[shape.material];
-            const vec3 a = std::get<DiffuseBsdf>(m.bsdf).albedo;  // staged_pass_applies: diffuse only
+            const DiffuseBsdf* diffuse = std::get_if<DiffuseBsdf>(&m.bsdf);
+            const bool in_lanes = diffuse && m.plain() && !m.textured();
+            const vec3 a = in_lanes ? diffuse->albedo : vec3(0.f);
             smooth.push_back(shape.smooth ? 1 : 0);
+            lane.push_back(in_lanes ? 1 : 0);
             albedo.insert(albedo.end(), {a.x, a.y, a.z});
             two_sided.push_back(m.two_sided ? 1 : 0);
         }
@@ -67,6 +72,7 @@ struct StagedScratch {
     std::vector<uint32_t> hit_path;  // per hit: its path
     std::vector<Hit> hits;
     std::vector<uint8_t> batched;    // the hit went through reconstruct_triangle_hits
+    std::vector<uint8_t> lane;       // the hit is shaded in lanes (else per path, stage 2b)
     std::vector<uint32_t> prim, shape;
     std::vector<float> b1, b2, p[3], err[3], ng[3], ns[3];  // what Scene::interaction gives
     std::vector<float> ray_d[3], beta[3], eta_scale;       // the path's ray and throughput
@@ -89,7 +95,7 @@ struct StagedScratch {
 };
 
 // Runs the paths whose indices are in `live` (all at depth 0; emptied on return) to their end.
-// Diffuse-only scenes without textures only (staged_pass_applies).
+// Scenes without masks (staged_pass_applies).
 template <class S>
 void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPath<S>>& paths,
                   std::vector<uint32_t>& live, StagedScratch& x, PathStats& stats) {
@@ -99,7 +105,8 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
     constexpr size_t kAlign = kDiffuseStepAlign > kHitBatchAlign ? kDiffuseStepAlign : kHitBatchAlign;
     static_assert(kAlign % kDiffuseStepAlign == 0 && kAlign % kHitBatchAlign == 0);
     x.reserve((paths.size() + kAlign - 1) / kAlign * kAlign);
-    ShadingT<true> sh;
+    ShadingT<true> sh;   // a hit shaded in lanes, when its light sample is not (the same as shade<false>)
+    ShadingT<false> shg; // a hit shaded per path
     // Every live path is at the same depth: they start together and each round is one bounce.
     for (int depth = 0; !live.empty(); ++depth) {
         x.next.clear();
@@ -132,13 +139,14 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
         // Stage 2a: hit reconstruction in SIMD lanes for the scene's own triangles (analytic shapes
         // and instances: Scene::interaction, per hit, in stage 2b).
         x.batched.assign(m, 0);
+        x.lane.assign(m, 0);
         size_t batched = 0;
         for (size_t j = 0; j < padded; ++j) {
             const bool tri = j < m && x.hits[j].kind == PrimKind::Triangle && x.hits[j].instance == ~0u;
             x.prim[j] = tri ? x.hits[j].prim : 0u;  // padding and other hits: triangle 0, ignored
             x.b1[j] = tri ? x.hits[j].b1 : 0.f;
             x.b2[j] = tri ? x.hits[j].b2 : 0.f;
-            if (tri) x.batched[j] = 1, ++batched;
+            if (tri) x.batched[j] = 1, x.lane[j] = tab.lane[sc.mesh.tri_shape[x.hits[j].prim]], ++batched;
         }
         // (A scene of analytic shapes only has an empty mesh: nothing to gather from.)
         if (batched > 0)
@@ -161,30 +169,36 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             x.u[0][j] = x.u[1][j] = 0.5f;
             x.u_rr[j] = 0.f;
         }
-        // Stage 2b: per path, emission, and the numbers of this bounce, drawn in Li's order: the
-        // light sample's (when Li draws them), the BSDF sample's (u1: the diffuse BSDF has one lobe,
-        // then u2), the roulette's when it applies. Li skips the roulette draw only for a path that
-        // has ended, whose sampler is never used again: drawing it first changes no number any
-        // path uses.
+        // Stage 2b: per path, emission; then, for a hit shaded in lanes, the numbers of this
+        // bounce, drawn in Li's order: the light sample's (when Li draws them), the BSDF sample's
+        // (u1: the diffuse BSDF has one lobe, then u2), the roulette's when it applies. Li skips
+        // the roulette draw only for a path that has ended, whose sampler is never used again:
+        // drawing it first changes no number any path uses. Any other hit makes its whole bounce
+        // here, as Li does, but for its shadow ray (traced with the round's).
         const bool bounce = !(st.max_depth >= 0 && depth >= st.max_depth);
         const bool rr = depth + 1 >= st.rr_depth;
         for (size_t j = 0; j < m; ++j) {
-            StagedPath<S>& p = paths[x.hit_path[j]];
+            const uint32_t i = x.hit_path[j];
+            StagedPath<S>& p = paths[i];
             const Hit& hit = x.hits[j];
-            if (!x.batched[j]) {
-                const SurfaceInteraction si = sc.interaction(hit);
-                for (int k = 0; k < 3; ++k) {
-                    x.p[k][j] = si.p[k];
-                    x.err[k][j] = si.p_error[k];
-                    x.ng[k][j] = si.ng[k];
-                    x.ns[k][j] = si.ns[k];
+            SurfaceInteraction si;
+            const bool whole_si = !x.batched[j] || !x.lane[j];
+            if (whole_si) {
+                si = sc.interaction(hit);
+                if (!x.batched[j]) {  // analytic shapes and instances: the lanes' inputs too
+                    for (int k = 0; k < 3; ++k) {
+                        x.p[k][j] = si.p[k];
+                        x.err[k][j] = si.p_error[k];
+                        x.ng[k][j] = si.ng[k];
+                        x.ns[k][j] = si.ns[k];
+                    }
+                    x.shape[j] = si.shape;
+                    x.lane[j] = tab.lane[si.shape];
                 }
-                x.shape[j] = si.shape;
                 add_emission(sc, hit, si, -glm::normalize(p.ray.d), p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf,
                              p.L);
             } else if (sc.lights.emitter_of(hit) >= 0) {
                 // uv, dpdu and dpdv stay unset: no untextured emitter reads them.
-                SurfaceInteraction si;
                 si.p = vec3(x.p[0][j], x.p[1][j], x.p[2][j]);
                 si.p_error = vec3(x.err[0][j], x.err[1][j], x.err[2][j]);
                 si.ng = vec3(x.ng[0][j], x.ng[1][j], x.ng[2][j]);
@@ -195,17 +209,59 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
                              p.L);
             }
             if (!bounce) continue;
-            if (mode != SamplingMode::Bsdf) {
-                x.u_l[j] = p.sampler.next_1d();
-                const vec2 up = p.sampler.next_2d();
-                x.u_lp[0][j] = up.x;
-                x.u_lp[1][j] = up.y;
+            if (x.lane[j]) {
+                if (mode != SamplingMode::Bsdf) {
+                    x.u_l[j] = p.sampler.next_1d();
+                    const vec2 up = p.sampler.next_2d();
+                    x.u_lp[0][j] = up.x;
+                    x.u_lp[1][j] = up.y;
+                }
+                p.sampler.next_1d();
+                const vec2 u2 = p.sampler.next_2d();
+                x.u[0][j] = u2.x;
+                x.u[1][j] = u2.y;
+                x.u_rr[j] = rr ? p.sampler.next_1d() : 0.f;
+                continue;
             }
-            p.sampler.next_1d();
+            // Li's bounce for one path (no masks: the shadow ray's transmittance is 0 or 1).
+            const vec3 wo_world = -glm::normalize(p.ray.d);
+            shade<false>(sc, hit, si, wo_world, shg);
+            if (mode != SamplingMode::Bsdf && have_lights && shg.has_smooth_component()) {
+                const float ul = p.sampler.next_1d();
+                const vec2 up = p.sampler.next_2d();
+                LightSample ls;
+                if (sc.lights.sample_li(si.p, ul, up, ls)) {
+                    const BsdfEval e = shg.eval_pdf(shg.frame.to_local(ls.wi));
+                    if (!is_black(e.f)) {
+                        p.shadow = shadow_ray(si, ls);
+                        ++stats.rays;
+                        const float T = 1.f;
+                        const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
+                        p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
+                        x.shadowed.push_back(i);
+                    }
+                }
+            } else if (mode != SamplingMode::Bsdf) {
+                p.sampler.next_1d();
+                p.sampler.next_2d();
+            }
+            const float u1 = p.sampler.next_1d();
             const vec2 u2 = p.sampler.next_2d();
-            x.u[0][j] = u2.x;
-            x.u[1][j] = u2.y;
-            x.u_rr[j] = rr ? p.sampler.next_1d() : 0.f;
+            const std::optional<BsdfSample> bs = shg.sample(u1, u2);
+            if (!bs || !(bs->pdf > 0.f)) continue;
+            p.beta *= bs->weight();
+            if (is_black(p.beta)) continue;
+            p.eta_scale *= sqr(bs->eta);
+            p.after_delta = bs->delta;
+            p.prev_pdf = bs->pdf;
+            p.prev_p = si.p;
+            p.ray = spawn_ray(si, shg.frame.to_world(bs->wi));
+            if (rr) {
+                const float q = std::min(max_component(p.beta) * p.eta_scale, 0.95f);
+                if (p.sampler.next_1d() >= q) continue;
+                p.beta /= q;
+            }
+            x.next.push_back(i);
         }
         if (!bounce || m == 0) break;  // no path goes on
         // Stage 2c: shading in SIMD lanes.
@@ -237,7 +293,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
                                                {x.sd[0].data(), x.sd[1].data(), x.sd[2].data()},
                                                {x.sL[0].data(), x.sL[1].data(), x.sL[2].data()}});
             for (size_t j = 0; j < m; ++j) {
-                if (!x.shadow[j]) continue;
+                if (!x.lane[j] || !x.shadow[j]) continue;
                 StagedPath<S>& p = paths[x.hit_path[j]];
                 p.shadow = Ray();
                 p.shadow.o = vec3(x.so[0][j], x.so[1][j], x.so[2][j]);
@@ -249,6 +305,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             }
         } else if (mode != SamplingMode::Bsdf && have_lights) {
             for (size_t j = 0; j < m; ++j) {
+                if (!x.lane[j]) continue;
                 StagedPath<S>& p = paths[x.hit_path[j]];
                 SurfaceInteraction si;  // what Scene::interaction gave (stage 2b), shaded as Li does
                 si.p = vec3(x.p[0][j], x.p[1][j], x.p[2][j]);
@@ -291,7 +348,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
                                          {x.dir[0].data(), x.dir[1].data(), x.dir[2].data()},
                                          x.alive.data()});
         for (size_t j = 0; j < m; ++j) {
-            if (!x.alive[j]) continue;
+            if (!x.lane[j] || !x.alive[j]) continue;
             StagedPath<S>& p = paths[x.hit_path[j]];
             p.beta = vec3(x.beta[0][j], x.beta[1][j], x.beta[2][j]);
             p.after_delta = false;
@@ -315,12 +372,10 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
 
 // Whether render_tiles_staged can render this pass (see the scope above).
 inline bool staged_pass_applies(const Scene& scene, const Film& film) {
-    if (!scene_is_diffuse_only(scene) || scene.lights.has_textured_emitter()) return false;
+    if (scene_has_masks(scene) || scene.lights.has_textured_emitter()) return false;
     // The lanes gather with 32-bit indices (3 floats per vertex and per triangle).
     constexpr size_t kMaxGathered = size_t(INT32_MAX) / 3;
     if (scene.mesh.positions.size() > kMaxGathered || scene.mesh.triangles.size() > kMaxGathered) return false;
-    for (const Material& m : scene.materials)
-        if (m.textured()) return false;
     return !film.weighted() && !film.adaptive() && film.aov_channels() == 0 && !film.has_alpha();
 }
 
