@@ -16,8 +16,11 @@ using namespace candela;
 namespace {
 
 // `min_lit`: pixels that must be non-black, so that the comparison is not between black images.
-void expect_same_films(const Scene& scene, int w, int h, int spp, int threads, int min_lit, const char* what) {
+// `weighted`: both films in the weighted layout (the scene's pixel filter splats each sample).
+void expect_same_films(const Scene& scene, int w, int h, int spp, int threads, int min_lit, const char* what,
+                       bool weighted = false) {
     Film a(w, h), b(w, h);
+    if (weighted) a.set_layout(true, 0), b.set_layout(true, 0);
     ASSERT_TRUE(staged_pass_applies(scene, b)) << what;
     PassStats pa = render_sampled_pass<PathIntegrator>(scene, a, 0, spp, threads, nullptr);
     PassStats pb = render_tiles_staged(scene, b, 0, spp, threads, nullptr,
@@ -33,6 +36,9 @@ void expect_same_films(const Scene& scene, int w, int h, int spp, int threads, i
             lit += sa != dvec3(0.0);
         }
     EXPECT_GE(lit, min_lit) << what << ": the comparison is between lit images";
+    ASSERT_EQ(a.weights().size(), b.weights().size());
+    EXPECT_EQ(std::memcmp(a.weights().data(), b.weights().data(), a.weights().size() * sizeof(double)), 0) << what;
+    EXPECT_EQ(weighted, !a.weights().empty()) << what;
 }
 
 }  // namespace
@@ -61,6 +67,24 @@ TEST(Staged, SameFilmAsThePerPathLoop) {
             const int min_lit = mode == SamplingMode::Bsdf ? (depth == -1 || depth == 7 ? 30 : 1) : 40 * 24 / 2;
             expect_same_films(*s, 40, 24, 3, 2, min_lit, what.c_str());
         }
+}
+
+TEST(Staged, WeightedFilmsWithTheScenesFilter) {
+    // Gaussian (matpreview's own) and a wide Lanczos: samples splat across tiles, one sample index
+    // at a time, on one and two threads.
+    auto mp = build_scene(load_scene(std::string(CANDELA_SHARED_DIR) + "/scenes-public/mdata_matpreview/matpreview.xml"));
+    ASSERT_FALSE(mp->settings.filter.is_box());
+    expect_same_films(*mp, 40, 24, 3, 2, 40 * 24 / 2, "matpreview, its gaussian filter", true);
+    SceneOverrides ov;
+    ov.width = 36;
+    ov.height = 20;
+    std::shared_ptr<const Scene> box = prepare_scene("", ov);
+    SceneParams p = box->params();
+    p.settings.filter.type = FilterType::Lanczos;
+    p.settings.filter.radius = 3.f;
+    std::shared_ptr<const Scene> s = box->with_params(p);
+    expect_same_films(*s, 36, 20, 2, 1, 36 * 20 / 2, "cornell box, lanczos radius 3, one thread", true);
+    expect_same_films(*s, 36, 20, 2, 2, 36 * 20 / 2, "cornell box, lanczos radius 3", true);
 }
 
 TEST(Staged, HiddenEmittersAndOneThread) {

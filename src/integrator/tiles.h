@@ -20,6 +20,7 @@
 // the moment wrapper's channels from the sample's radiance after it.
 #include <omp.h>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <type_traits>
@@ -95,6 +96,83 @@ inline TileRange tile_range(int tile, int tiles_x, int w, int h) {
     return {x0, y0, std::min(x0 + kTileSize, w), std::min(y0 + kTileSize, h)};
 }
 
+// What every pass's tile loop shares: the film's tiles, the camera set to the film's size, the
+// totals and the cancel flag; and the two loops, one per film layout. `body` runs inside an OpenMP
+// parallel loop (omp_get_thread_num() picks per-thread scratch) and adds its rays and samples.
+class TilePass {
+public:
+    TilePass(const Scene& scene, const Film& film, const std::atomic<bool>* cancel)
+        : w(film.width()), h(film.height()), tiles_x((w + kTileSize - 1) / kTileSize),
+          n_tiles(tiles_x * ((h + kTileSize - 1) / kTileSize)), camera(scene.camera), cancel_(cancel) {
+        camera.set_film_size(w, h);  // a preview renders the same view at a smaller size
+    }
+    const int w, h, tiles_x, n_tiles;
+    Camera camera;
+
+    bool cancelled() {
+        if (stopped_.load(std::memory_order_relaxed)) return true;
+        if (cancel_ && cancel_->load(std::memory_order_relaxed)) {
+            stopped_ = true;
+            return true;
+        }
+        return false;
+    }
+    void add(uint64_t rays, uint64_t samples) {
+        rays_.fetch_add(rays, std::memory_order_relaxed);
+        samples_.fetch_add(samples, std::memory_order_relaxed);
+    }
+    PassStats stats() const {
+        PassStats out;
+        out.rays = rays_.load();
+        out.samples = samples_.load();
+        out.completed = !stopped_.load();
+        return out;
+    }
+
+    // Unweighted film: body(TileRange) per tile. Each tile writes only its own pixels.
+    template <class Body>
+    void unweighted(int n_threads, const Body& body) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+        for (int tile = 0; tile < n_tiles; ++tile) {
+            if (cancelled()) continue;
+            body(tile_range(tile, tiles_x, w, h));
+        }
+    }
+    // Weighted film: one sample index s at a time, body(TileRange, s, FilmTile&) per tile into its
+    // own FilmTile, then the tiles merged in tile order into a zeroed layer, which is added to the
+    // film: the film is the sum of per-index layers in index order, what an MPI rank 0 can
+    // rebuild from layers rendered elsewhere (Film::add).
+    template <class Body>
+    void weighted(Film& film, float reach, int spp, int n_threads, const Body& body) {
+        std::vector<FilmTile> tiles(static_cast<size_t>(n_tiles));
+        std::vector<char> done(static_cast<size_t>(n_tiles));
+        Film layer(w, h);
+        layer.set_layout(true, film.aov_channels());
+        if (film.has_alpha()) layer.enable_alpha();
+        for (int s = 0; s < spp && !cancelled(); ++s) {
+            std::fill(done.begin(), done.end(), 0);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
+            for (int tile = 0; tile < n_tiles; ++tile) {
+                if (cancelled()) continue;
+                const TileRange tr = tile_range(tile, tiles_x, w, h);
+                FilmTile& ft = tiles[size_t(tile)];
+                ft.reset(film, tr.x0, tr.y0, tr.x1, tr.y1, reach);
+                body(tr, s, ft);
+                done[size_t(tile)] = 1;
+            }
+            layer.clear();
+            for (int tile = 0; tile < n_tiles; ++tile)
+                if (done[size_t(tile)]) layer.merge(tiles[size_t(tile)]);
+            film.add(layer);
+        }
+    }
+
+private:
+    const std::atomic<bool>* cancel_;
+    std::atomic<uint64_t> rays_{0}, samples_{0};
+    std::atomic<bool> stopped_{false};
+};
+
 }  // namespace detail
 
 // The sampler of a pass over `film`: the scene's, its seed and sample_count, and the range of the
@@ -113,41 +191,22 @@ inline SamplerSetup sampler_setup(const Scene& scene, const Film& film) {
 template <class S, class Li>
 PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
                        const std::atomic<bool>* cancel, const S& prototype, const Li& li) {
-    const int w = film.width(), h = film.height();
-    const int tiles_x = (w + kTileSize - 1) / kTileSize;
-    const int tiles_y = (h + kTileSize - 1) / kTileSize;
-    const int n_tiles = tiles_x * tiles_y;
-    // The scene's camera for this film: a preview renders the same view at a smaller size.
-    Camera camera = scene.camera;
-    camera.set_film_size(w, h);
+    detail::TilePass pass(scene, film, cancel);
+    const Camera& camera = pass.camera;
     const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
     const int n_aov = film.aov_channels();
     const int moment_at = moment_offset(aovs);
     const vec3 eye = camera.origin();
     const bool alpha = film.has_alpha();
-    std::atomic<uint64_t> total_rays{0}, total_samples{0};
-    std::atomic<bool> stopped{false};
-    auto cancelled = [&] {
-        if (stopped.load(std::memory_order_relaxed)) return true;
-        if (cancel && cancel->load(std::memory_order_relaxed)) {
-            stopped = true;
-            return true;
-        }
-        return false;
-    };
-
     if (!film.weighted()) {
         // Adaptive sampling (film/adaptive.h): pixels the stopping rule marked inactive between
         // passes are skipped; a sample's index parity picks its half of the film.
         const bool adaptive = film.adaptive();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            if (cancelled()) continue;
+        pass.unweighted(n_threads, [&](const detail::TileRange& tr) {
             S sampler = prototype;
             PathStats ps;
             uint64_t samples = 0;
             float aov[64];
-            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x) {
                     if (adaptive && !film.active(x, y)) continue;
@@ -173,66 +232,39 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                         ++samples;
                     }
                 }
-            total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
-            total_samples.fetch_add(samples, std::memory_order_relaxed);
-        }
+            pass.add(ps.rays, samples);
+        });
     } else {
         const PixelFilter filter(scene.settings.filter);
-        std::vector<FilmTile> tiles(static_cast<size_t>(n_tiles));
-        std::vector<char> done(static_cast<size_t>(n_tiles));
-        Film layer(w, h);
-        layer.set_layout(true, n_aov);
-        if (alpha) layer.enable_alpha();
-        for (int s = 0; s < spp && !cancelled(); ++s) {
-            std::fill(done.begin(), done.end(), 0);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(n_threads)
-            for (int tile = 0; tile < n_tiles; ++tile) {
-                if (cancelled()) continue;
-                S sampler = prototype;
-                PathStats ps;
-                uint64_t samples = 0;
-                float aov[64];
-                const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
-                FilmTile& ft = tiles[size_t(tile)];
-                ft.reset(film, tr.x0, tr.y0, tr.x1, tr.y1, filter.reach());
-                for (int y = tr.y0; y < tr.y1; ++y)
-                    for (int x = tr.x0; x < tr.x1; ++x) {
-                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                        const vec2 jitter = sampler.next_2d();
-                        const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
-                        // The filter works in this film's pixels (a crop window only shifts them).
-                        const vec2 pos = vec2(float(x), float(y)) + jitter;
-                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
-                        if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
-                        const uint64_t hits = ps.camera_hits;
-                        vec3 L = li(sampler, ray, ps);
-                        if (!all_finite(L)) {
-                            film.count_nonfinite();
-                            L = vec3(0.f);
-                        }
-                        film.count_sample(ivec2(x, y));
-                        if (moment_at >= 0) write_moment(aov + moment_at, L);
-                        detail::splat(ft, filter, w, h, pos, L, aov, ps.camera_hits != hits);
-                        ++samples;
+        pass.weighted(film, filter.reach(), spp, n_threads, [&](const detail::TileRange& tr, int s, FilmTile& ft) {
+            S sampler = prototype;
+            PathStats ps;
+            uint64_t samples = 0;
+            float aov[64];
+            for (int y = tr.y0; y < tr.y1; ++y)
+                for (int x = tr.x0; x < tr.x1; ++x) {
+                    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
+                    const vec2 jitter = sampler.next_2d();
+                    const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                    // The filter works in this film's pixels (a crop window only shifts them).
+                    const vec2 pos = vec2(float(x), float(y)) + jitter;
+                    Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                    if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
+                    const uint64_t hits = ps.camera_hits;
+                    vec3 L = li(sampler, ray, ps);
+                    if (!all_finite(L)) {
+                        film.count_nonfinite();
+                        L = vec3(0.f);
                     }
-                done[size_t(tile)] = 1;
-                total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
-                total_samples.fetch_add(samples, std::memory_order_relaxed);
-            }
-            // The tiles of index s go into a zeroed layer, which is then added to the film: the
-            // film is the sum of per-index layers in index order, what an MPI rank 0 can rebuild
-            // from layers rendered elsewhere (Film::add).
-            layer.clear();
-            for (int tile = 0; tile < n_tiles; ++tile)
-                if (done[size_t(tile)]) layer.merge(tiles[size_t(tile)]);
-            film.add(layer);
-        }
+                    film.count_sample(ivec2(x, y));
+                    if (moment_at >= 0) write_moment(aov + moment_at, L);
+                    detail::splat(ft, filter, pass.w, pass.h, pos, L, aov, ps.camera_hits != hits);
+                    ++samples;
+                }
+            pass.add(ps.rays, samples);
+        });
     }
-    PassStats out;
-    out.rays = total_rays.load();
-    out.samples = total_samples.load();
-    out.completed = !stopped.load();
-    return out;
+    return pass.stats();
 }
 
 // A pass of a per-ray integrator (`Integrator(scene).Li<S, DiffuseOnly>(ray, sampler, stats)`)

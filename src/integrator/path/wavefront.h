@@ -3,14 +3,15 @@
 // (docs/wavefront.md has the plan and the measurements).
 //
 // A tile's paths (its pixels times the pass's samples) advance together, one bounce per round:
-//   1. the closest hit of every live path (traversal stays per ray: it is at Embree's speed);
-//   2. hit reconstruction of the round's triangle hits in SIMD lanes (hit_soa.h); then per path,
-//      emission and the numbers of this bounce, drawn in Li's order. A hit on a material other
-//      than plain, untextured diffuse makes its whole bounce here, per path, as Li does;
-//   3. in SIMD lanes, for the diffuse hits: the shading (frame, wo, albedo), the light samples when
-//      the lights are emissive triangles (the shadow ray and its contribution, computed as if
-//      unoccluded; per path otherwise) and the diffuse step: BSDF sample, throughput, next ray,
-//      roulette (diffuse_step.h);
+//   1. the closest hit of every live path (traversal stays per ray: it is at Embree's speed). A
+//      hit on the scene's own triangles with a plain, untextured diffuse material takes a lane;
+//   2. the lanes' hit reconstruction in SIMD lanes (hit_soa.h), then per lane emission and the
+//      numbers of this bounce, drawn in Li's order. Every other hit (other materials, analytic
+//      shapes, instances) makes its whole bounce here, per path, as Li does;
+//   3. in SIMD lanes: the shading (frame, wo, albedo), the light samples when the lights are
+//      emissive triangles (the shadow ray and its contribution, computed as if unoccluded; per
+//      path otherwise) and the diffuse step: BSDF sample, throughput, next ray, roulette
+//      (diffuse_step.h);
 //   4. the round's shadow rays; each adds its contribution when unoccluded (the shadow ray's
 //      outcome changes no sampler draw and no throughput, so the path went on before).
 // Each path makes the operations of PathIntegrator::Li (path_impl.h) in the same order, and the
@@ -18,8 +19,8 @@
 // (tests/test_staged.cpp compares the films on every SIMD target).
 //
 // Scope (staged_pass_applies): scenes without masks or textured emitters, the independent
-// sampler, an unweighted film (box filter) without adaptive sampling, AOVs or alpha. The path
-// pass uses the per-path loop otherwise, and with CANDELA_STAGED=0.
+// sampler, films without adaptive sampling, AOVs or alpha (any pixel filter). The path pass uses
+// the per-path loop otherwise, and with CANDELA_STAGED=0.
 #include <climits>
 #include <vector>
 #include "integrator/path.h"
@@ -66,13 +67,12 @@ struct StagedTables {
 };
 
 // What trace_staged reuses from round to round (one per thread). The arrays are the round's
-// hits, in path order, padded for the SIMD lanes.
+// lanes (its hits shaded in lanes, in path order), padded for the SIMD batches.
 struct StagedScratch {
     std::vector<uint32_t> next, shadowed;
-    std::vector<uint32_t> hit_path;  // per hit: its path
-    std::vector<Hit> hits;
-    std::vector<uint8_t> batched;    // the hit went through reconstruct_triangle_hits
-    std::vector<uint8_t> lane;       // the hit is shaded in lanes (else per path, stage 2b)
+    std::vector<uint32_t> lane_path;                        // per lane: its path
+    std::vector<Hit> lane_hit;                              // per lane: its hit
+    std::vector<std::pair<uint32_t, Hit>> other;            // the round's other hits and their paths
     std::vector<uint32_t> prim, shape;
     std::vector<float> b1, b2, p[3], err[3], ng[3], ns[3];  // what Scene::interaction gives
     std::vector<float> ray_d[3], beta[3], eta_scale;       // the path's ray and throughput
@@ -84,7 +84,8 @@ struct StagedScratch {
 
     void reserve(size_t cap) {
         if (prim.size() >= cap) return;
-        for (auto* v : {&prim, &shape}) v->resize(cap);
+        for (auto* v : {&lane_path, &prim, &shape}) v->resize(cap);
+        lane_hit.resize(cap);
         for (auto* v : {&alive, &shadow}) v->resize(cap);
         for (auto* v : {&b1, &b2, &eta_scale, &wo_z, &u_l, &u_lp[0], &u_lp[1], &u[0], &u[1], &u_rr, &pdf}) v->resize(cap);
         for (int k = 0; k < 3; ++k)
@@ -105,15 +106,16 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
     constexpr size_t kAlign = kDiffuseStepAlign > kHitBatchAlign ? kDiffuseStepAlign : kHitBatchAlign;
     static_assert(kAlign % kDiffuseStepAlign == 0 && kAlign % kHitBatchAlign == 0);
     x.reserve((paths.size() + kAlign - 1) / kAlign * kAlign);
-    ShadingT<true> sh;   // a hit shaded in lanes, when its light sample is not (the same as shade<false>)
-    ShadingT<false> shg; // a hit shaded per path
+    ShadingT<true> sh;   // a lane's shading, when its light sample is made per path
+    ShadingT<false> shg; // another hit's
     // Every live path is at the same depth: they start together and each round is one bounce.
     for (int depth = 0; !live.empty(); ++depth) {
         x.next.clear();
         x.shadowed.clear();
-        x.hit_path.clear();
-        x.hits.clear();
-        // Stage 1: closest hits.
+        x.other.clear();
+        // Stage 1: closest hits. A hit on the scene's own triangles with a plain, untextured
+        // diffuse material takes a lane; any other is shaded per path.
+        size_t nl = 0;
         for (const uint32_t i : live) {
             StagedPath<S>& p = paths[i];
             Hit hit;
@@ -125,106 +127,88 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             }
             if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, p.ray, hit, stats)) continue;
             if (depth == 0) ++stats.camera_hits;
-            const size_t j = x.hits.size();
-            x.hit_path.push_back(i);
-            x.hits.push_back(hit);
-            for (int k = 0; k < 3; ++k) {
-                x.ray_d[k][j] = p.ray.d[k];
-                x.beta[k][j] = p.beta[k];
+            if (hit.kind != PrimKind::Triangle || hit.instance != ~0u || !tab.lane[sc.mesh.tri_shape[hit.prim]]) {
+                x.other.emplace_back(i, hit);
+                continue;
             }
-            x.eta_scale[j] = p.eta_scale;
+            const size_t q = nl++;
+            x.lane_path[q] = i;
+            x.lane_hit[q] = hit;
+            x.prim[q] = hit.prim;
+            x.b1[q] = hit.b1;
+            x.b2[q] = hit.b2;
+            for (int k = 0; k < 3; ++k) {
+                x.ray_d[k][q] = p.ray.d[k];
+                x.beta[k][q] = p.beta[k];
+            }
+            x.eta_scale[q] = p.eta_scale;
         }
-        const size_t m = x.hits.size();
-        const size_t padded = (m + kAlign - 1) / kAlign * kAlign;
-        // Stage 2a: hit reconstruction in SIMD lanes for the scene's own triangles (analytic shapes
-        // and instances: Scene::interaction, per hit, in stage 2b).
-        x.batched.assign(m, 0);
-        x.lane.assign(m, 0);
-        size_t batched = 0;
-        for (size_t j = 0; j < padded; ++j) {
-            const bool tri = j < m && x.hits[j].kind == PrimKind::Triangle && x.hits[j].instance == ~0u;
-            x.prim[j] = tri ? x.hits[j].prim : 0u;  // padding and other hits: triangle 0, ignored
-            x.b1[j] = tri ? x.hits[j].b1 : 0.f;
-            x.b2[j] = tri ? x.hits[j].b2 : 0.f;
-            if (tri) x.batched[j] = 1, x.lane[j] = tab.lane[sc.mesh.tri_shape[x.hits[j].prim]], ++batched;
+        // Padding lanes: finite values, results ignored.
+        const size_t padded = (nl + kAlign - 1) / kAlign * kAlign;
+        for (size_t q = nl; q < padded; ++q) {
+            x.prim[q] = 0;  // a valid triangle
+            x.b1[q] = x.b2[q] = 0.f;
+            for (int k = 0; k < 3; ++k) {
+                x.beta[k][q] = 0.f;
+                x.ray_d[k][q] = k == 2 ? 1.f : 0.f;
+            }
+            x.eta_scale[q] = 1.f;
+            x.u_l[q] = 0.5f;
+            x.u_lp[0][q] = x.u_lp[1][q] = 0.25f;
+            x.u[0][q] = x.u[1][q] = 0.5f;
+            x.u_rr[q] = 0.f;
         }
-        // (A scene of analytic shapes only has an empty mesh: nothing to gather from.)
-        if (batched > 0)
-            reconstruct_triangle_hits(sc.mesh, tab.smooth.data(), m, HitBatch{x.prim.data(), x.b1.data(), x.b2.data()},
+        // Stage 2a: the lanes' hit reconstruction in SIMD lanes.
+        if (nl > 0)
+            reconstruct_triangle_hits(sc.mesh, tab.smooth.data(), nl, HitBatch{x.prim.data(), x.b1.data(), x.b2.data()},
                                       SurfaceBatch{{x.p[0].data(), x.p[1].data(), x.p[2].data()},
                                                    {x.err[0].data(), x.err[1].data(), x.err[2].data()},
                                                    {x.ng[0].data(), x.ng[1].data(), x.ng[2].data()},
                                                    {x.ns[0].data(), x.ns[1].data(), x.ns[2].data()},
                                                    x.shape.data()});
-        // Padding lanes: finite values, results ignored.
-        for (size_t j = m; j < padded; ++j) {
-            for (int k = 0; k < 3; ++k) {
-                x.p[k][j] = x.err[k][j] = x.beta[k][j] = 0.f;
-                x.ng[k][j] = x.ns[k][j] = x.ray_d[k][j] = k == 2 ? 1.f : 0.f;
-            }
-            x.shape[j] = 0;
-            x.eta_scale[j] = 1.f;
-            x.u_l[j] = 0.5f;
-            x.u_lp[0][j] = x.u_lp[1][j] = 0.25f;
-            x.u[0][j] = x.u[1][j] = 0.5f;
-            x.u_rr[j] = 0.f;
-        }
-        // Stage 2b: per path, emission; then, for a hit shaded in lanes, the numbers of this
-        // bounce, drawn in Li's order: the light sample's (when Li draws them), the BSDF sample's
-        // (u1: the diffuse BSDF has one lobe, then u2), the roulette's when it applies. Li skips
-        // the roulette draw only for a path that has ended, whose sampler is never used again:
-        // drawing it first changes no number any path uses. Any other hit makes its whole bounce
-        // here, as Li does, but for its shadow ray (traced with the round's).
+        // Stage 2b: per lane, emission and the numbers of this bounce, drawn in Li's order: the
+        // light sample's (when Li draws them), the BSDF sample's (u1: the diffuse BSDF has one
+        // lobe, then u2), the roulette's when it applies. Li skips the roulette draw only for a
+        // path that has ended, whose sampler is never used again: drawing it first changes no
+        // number any path uses.
         const bool bounce = !(st.max_depth >= 0 && depth >= st.max_depth);
         const bool rr = depth + 1 >= st.rr_depth;
-        for (size_t j = 0; j < m; ++j) {
-            const uint32_t i = x.hit_path[j];
-            StagedPath<S>& p = paths[i];
-            const Hit& hit = x.hits[j];
-            SurfaceInteraction si;
-            const bool whole_si = !x.batched[j] || !x.lane[j];
-            if (whole_si) {
-                si = sc.interaction(hit);
-                if (!x.batched[j]) {  // analytic shapes and instances: the lanes' inputs too
-                    for (int k = 0; k < 3; ++k) {
-                        x.p[k][j] = si.p[k];
-                        x.err[k][j] = si.p_error[k];
-                        x.ng[k][j] = si.ng[k];
-                        x.ns[k][j] = si.ns[k];
-                    }
-                    x.shape[j] = si.shape;
-                    x.lane[j] = tab.lane[si.shape];
-                }
-                add_emission(sc, hit, si, -glm::normalize(p.ray.d), p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf,
-                             p.L);
-            } else if (sc.lights.emitter_of(hit) >= 0) {
+        for (size_t q = 0; q < nl; ++q) {
+            StagedPath<S>& p = paths[x.lane_path[q]];
+            const Hit& hit = x.lane_hit[q];
+            if (sc.lights.emitter_of(hit) >= 0) {
                 // uv, dpdu and dpdv stay unset: no untextured emitter reads them.
-                si.p = vec3(x.p[0][j], x.p[1][j], x.p[2][j]);
-                si.p_error = vec3(x.err[0][j], x.err[1][j], x.err[2][j]);
-                si.ng = vec3(x.ng[0][j], x.ng[1][j], x.ng[2][j]);
-                si.ns = vec3(x.ns[0][j], x.ns[1][j], x.ns[2][j]);
+                SurfaceInteraction si;
+                si.p = vec3(x.p[0][q], x.p[1][q], x.p[2][q]);
+                si.p_error = vec3(x.err[0][q], x.err[1][q], x.err[2][q]);
+                si.ng = vec3(x.ng[0][q], x.ng[1][q], x.ng[2][q]);
+                si.ns = vec3(x.ns[0][q], x.ns[1][q], x.ns[2][q]);
                 si.prim = hit.prim;
-                si.shape = x.shape[j];
+                si.shape = x.shape[q];
                 add_emission(sc, hit, si, -glm::normalize(p.ray.d), p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf,
                              p.L);
             }
             if (!bounce) continue;
-            if (x.lane[j]) {
-                if (mode != SamplingMode::Bsdf) {
-                    x.u_l[j] = p.sampler.next_1d();
-                    const vec2 up = p.sampler.next_2d();
-                    x.u_lp[0][j] = up.x;
-                    x.u_lp[1][j] = up.y;
-                }
-                p.sampler.next_1d();
-                const vec2 u2 = p.sampler.next_2d();
-                x.u[0][j] = u2.x;
-                x.u[1][j] = u2.y;
-                x.u_rr[j] = rr ? p.sampler.next_1d() : 0.f;
-                continue;
+            if (mode != SamplingMode::Bsdf) {
+                x.u_l[q] = p.sampler.next_1d();
+                const vec2 up = p.sampler.next_2d();
+                x.u_lp[0][q] = up.x;
+                x.u_lp[1][q] = up.y;
             }
-            // Li's bounce for one path (no masks: the shadow ray's transmittance is 0 or 1).
+            p.sampler.next_1d();
+            const vec2 u2 = p.sampler.next_2d();
+            x.u[0][q] = u2.x;
+            x.u[1][q] = u2.y;
+            x.u_rr[q] = rr ? p.sampler.next_1d() : 0.f;
+        }
+        // Stage 2c: every other hit makes its whole bounce here, as Li does, but for its shadow
+        // ray (traced with the round's; no masks: its transmittance is 0 or 1).
+        for (const auto& [i, hit] : x.other) {
+            StagedPath<S>& p = paths[i];
+            SurfaceInteraction si = sc.interaction(hit);
             const vec3 wo_world = -glm::normalize(p.ray.d);
+            add_emission(sc, hit, si, wo_world, p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf, p.L);
+            if (!bounce) continue;
             shade<false>(sc, hit, si, wo_world, shg);
             if (mode != SamplingMode::Bsdf && have_lights && shg.has_smooth_component()) {
                 const float ul = p.sampler.next_1d();
@@ -263,104 +247,103 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             }
             x.next.push_back(i);
         }
-        if (!bounce || m == 0) break;  // no path goes on
-        // Stage 2c: shading in SIMD lanes.
-        shade_diffuse(m, tab.albedo.data(), tab.two_sided.data(),
-                      ShadeDiffuseBatch{{x.ray_d[0].data(), x.ray_d[1].data(), x.ray_d[2].data()},
-                                        {x.ns[0].data(), x.ns[1].data(), x.ns[2].data()},
-                                        {x.ng[0].data(), x.ng[1].data(), x.ng[2].data()},
-                                        x.shape.data(),
-                                        {x.n[0].data(), x.n[1].data(), x.n[2].data()},
-                                        {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
-                                        x.wo_z.data(),
-                                        {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()}});
-        // Stage 2d: the light samples, in SIMD lanes when the lights allow, else per path; each
-        // computed as if unoccluded.
-        if (tab.lanes_nee) {
-            area_light_step(m, tab.lights.cdf, tab.lights.tri, tab.lights.radiance, tab.lights.entries,
-                            mode == SamplingMode::Mis,
-                            AreaLightStepBatch{x.u_l.data(),
-                                               {x.u_lp[0].data(), x.u_lp[1].data()},
-                                               {x.p[0].data(), x.p[1].data(), x.p[2].data()},
-                                               {x.err[0].data(), x.err[1].data(), x.err[2].data()},
-                                               {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
-                                               {x.n[0].data(), x.n[1].data(), x.n[2].data()},
-                                               x.wo_z.data(),
-                                               {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
-                                               {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
-                                               x.shadow.data(),
-                                               {x.so[0].data(), x.so[1].data(), x.so[2].data()},
-                                               {x.sd[0].data(), x.sd[1].data(), x.sd[2].data()},
-                                               {x.sL[0].data(), x.sL[1].data(), x.sL[2].data()}});
-            for (size_t j = 0; j < m; ++j) {
-                if (!x.lane[j] || !x.shadow[j]) continue;
-                StagedPath<S>& p = paths[x.hit_path[j]];
-                p.shadow = Ray();
-                p.shadow.o = vec3(x.so[0][j], x.so[1][j], x.so[2][j]);
-                p.shadow.d = vec3(x.sd[0][j], x.sd[1][j], x.sd[2][j]);
-                p.shadow.tmax = 1.f - kShadowEpsilon;
-                p.shadow_L = vec3(x.sL[0][j], x.sL[1][j], x.sL[2][j]);
-                ++stats.rays;
-                x.shadowed.push_back(x.hit_path[j]);
+        if (!bounce) break;  // no path goes on
+        if (nl > 0) {
+            // Stage 3a: the lanes' shading.
+            shade_diffuse(nl, tab.albedo.data(), tab.two_sided.data(),
+                          ShadeDiffuseBatch{{x.ray_d[0].data(), x.ray_d[1].data(), x.ray_d[2].data()},
+                                            {x.ns[0].data(), x.ns[1].data(), x.ns[2].data()},
+                                            {x.ng[0].data(), x.ng[1].data(), x.ng[2].data()},
+                                            x.shape.data(),
+                                            {x.n[0].data(), x.n[1].data(), x.n[2].data()},
+                                            {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
+                                            x.wo_z.data(),
+                                            {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()}});
+            // Stage 3b: the lanes' light samples, in SIMD lanes when the lights allow, else per
+            // path; each computed as if unoccluded.
+            if (tab.lanes_nee) {
+                area_light_step(nl, tab.lights.cdf, tab.lights.tri, tab.lights.radiance, tab.lights.entries,
+                                mode == SamplingMode::Mis,
+                                AreaLightStepBatch{x.u_l.data(),
+                                                   {x.u_lp[0].data(), x.u_lp[1].data()},
+                                                   {x.p[0].data(), x.p[1].data(), x.p[2].data()},
+                                                   {x.err[0].data(), x.err[1].data(), x.err[2].data()},
+                                                   {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
+                                                   {x.n[0].data(), x.n[1].data(), x.n[2].data()},
+                                                   x.wo_z.data(),
+                                                   {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
+                                                   {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
+                                                   x.shadow.data(),
+                                                   {x.so[0].data(), x.so[1].data(), x.so[2].data()},
+                                                   {x.sd[0].data(), x.sd[1].data(), x.sd[2].data()},
+                                                   {x.sL[0].data(), x.sL[1].data(), x.sL[2].data()}});
+                for (size_t q = 0; q < nl; ++q) {
+                    if (!x.shadow[q]) continue;
+                    StagedPath<S>& p = paths[x.lane_path[q]];
+                    p.shadow = Ray();
+                    p.shadow.o = vec3(x.so[0][q], x.so[1][q], x.so[2][q]);
+                    p.shadow.d = vec3(x.sd[0][q], x.sd[1][q], x.sd[2][q]);
+                    p.shadow.tmax = 1.f - kShadowEpsilon;
+                    p.shadow_L = vec3(x.sL[0][q], x.sL[1][q], x.sL[2][q]);
+                    ++stats.rays;
+                    x.shadowed.push_back(x.lane_path[q]);
+                }
+            } else if (mode != SamplingMode::Bsdf && have_lights) {
+                for (size_t q = 0; q < nl; ++q) {
+                    StagedPath<S>& p = paths[x.lane_path[q]];
+                    SurfaceInteraction si;  // what Scene::interaction gives, shaded as Li does
+                    si.p = vec3(x.p[0][q], x.p[1][q], x.p[2][q]);
+                    si.p_error = vec3(x.err[0][q], x.err[1][q], x.err[2][q]);
+                    si.ng = vec3(x.ng[0][q], x.ng[1][q], x.ng[2][q]);
+                    si.ns = vec3(x.ns[0][q], x.ns[1][q], x.ns[2][q]);
+                    si.prim = x.lane_hit[q].prim;
+                    si.shape = x.shape[q];
+                    shade<true>(sc, x.lane_hit[q], si, -glm::normalize(p.ray.d), sh);
+                    LightSample ls;
+                    if (!sc.lights.sample_li(si.p, x.u_l[q], vec2(x.u_lp[0][q], x.u_lp[1][q]), ls)) continue;
+                    const BsdfEval e = sh.eval_pdf(sh.frame.to_local(ls.wi));
+                    if (is_black(e.f)) continue;
+                    p.shadow = shadow_ray(si, ls);
+                    ++stats.rays;
+                    // Li's weight with transmittance T = 1 (no masks): e.pdf * 1 and 1 * w are exact.
+                    const float T = 1.f;
+                    const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
+                    p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
+                    x.shadowed.push_back(x.lane_path[q]);
+                }
             }
-        } else if (mode != SamplingMode::Bsdf && have_lights) {
-            for (size_t j = 0; j < m; ++j) {
-                if (!x.lane[j]) continue;
-                StagedPath<S>& p = paths[x.hit_path[j]];
-                SurfaceInteraction si;  // what Scene::interaction gave (stage 2b), shaded as Li does
-                si.p = vec3(x.p[0][j], x.p[1][j], x.p[2][j]);
-                si.p_error = vec3(x.err[0][j], x.err[1][j], x.err[2][j]);
-                si.ng = vec3(x.ng[0][j], x.ng[1][j], x.ng[2][j]);
-                si.ns = vec3(x.ns[0][j], x.ns[1][j], x.ns[2][j]);
-                si.prim = x.hits[j].prim;
-                si.shape = x.shape[j];
-                shade<true>(sc, x.hits[j], si, -glm::normalize(p.ray.d), sh);
-                if (!sh.has_smooth_component()) continue;
-                LightSample ls;
-                if (!sc.lights.sample_li(si.p, x.u_l[j], vec2(x.u_lp[0][j], x.u_lp[1][j]), ls)) continue;
-                const vec3 wi = sh.frame.to_local(ls.wi);
-                const BsdfEval e = sh.eval_pdf(wi);
-                if (is_black(e.f)) continue;
-                p.shadow = shadow_ray(si, ls);
-                ++stats.rays;
-                // Li's weight with transmittance T = 1 (no masks): e.pdf * 1 and 1 * w are exact.
-                const float T = 1.f;
-                const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
-                p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
-                x.shadowed.push_back(x.hit_path[j]);
+            // Stage 3c: the lanes' diffuse step (BSDF sample, throughput, next ray, roulette),
+            // then the paths that go on.
+            diffuse_step(nl, DiffuseStepBatch{{x.n[0].data(), x.n[1].data(), x.n[2].data()},
+                                              x.wo_z.data(),
+                                              {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
+                                              {x.u[0].data(), x.u[1].data()},
+                                              x.u_rr.data(),
+                                              rr,
+                                              x.eta_scale.data(),
+                                              {x.p[0].data(), x.p[1].data(), x.p[2].data()},
+                                              {x.err[0].data(), x.err[1].data(), x.err[2].data()},
+                                              {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
+                                              {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
+                                              x.pdf.data(),
+                                              {x.o[0].data(), x.o[1].data(), x.o[2].data()},
+                                              {x.dir[0].data(), x.dir[1].data(), x.dir[2].data()},
+                                              x.alive.data()});
+            for (size_t q = 0; q < nl; ++q) {
+                if (!x.alive[q]) continue;
+                StagedPath<S>& p = paths[x.lane_path[q]];
+                p.beta = vec3(x.beta[0][q], x.beta[1][q], x.beta[2][q]);
+                p.after_delta = false;
+                p.prev_pdf = x.pdf[q];
+                p.prev_p = vec3(x.p[0][q], x.p[1][q], x.p[2][q]);
+                p.ray = Ray();
+                p.ray.o = vec3(x.o[0][q], x.o[1][q], x.o[2][q]);
+                p.ray.d = vec3(x.dir[0][q], x.dir[1][q], x.dir[2][q]);
+                x.next.push_back(x.lane_path[q]);
             }
         }
-        // Stage 2e: the diffuse step (BSDF sample, throughput, next ray, roulette) in SIMD lanes,
-        // then the paths that go on, in path order.
-        diffuse_step(m, DiffuseStepBatch{{x.n[0].data(), x.n[1].data(), x.n[2].data()},
-                                         x.wo_z.data(),
-                                         {x.albedo[0].data(), x.albedo[1].data(), x.albedo[2].data()},
-                                         {x.u[0].data(), x.u[1].data()},
-                                         x.u_rr.data(),
-                                         rr,
-                                         x.eta_scale.data(),
-                                         {x.p[0].data(), x.p[1].data(), x.p[2].data()},
-                                         {x.err[0].data(), x.err[1].data(), x.err[2].data()},
-                                         {x.sng[0].data(), x.sng[1].data(), x.sng[2].data()},
-                                         {x.beta[0].data(), x.beta[1].data(), x.beta[2].data()},
-                                         x.pdf.data(),
-                                         {x.o[0].data(), x.o[1].data(), x.o[2].data()},
-                                         {x.dir[0].data(), x.dir[1].data(), x.dir[2].data()},
-                                         x.alive.data()});
-        for (size_t j = 0; j < m; ++j) {
-            if (!x.lane[j] || !x.alive[j]) continue;
-            StagedPath<S>& p = paths[x.hit_path[j]];
-            p.beta = vec3(x.beta[0][j], x.beta[1][j], x.beta[2][j]);
-            p.after_delta = false;
-            p.prev_pdf = x.pdf[j];
-            p.prev_p = vec3(x.p[0][j], x.p[1][j], x.p[2][j]);
-            p.ray = Ray();
-            p.ray.o = vec3(x.o[0][j], x.o[1][j], x.o[2][j]);
-            p.ray.d = vec3(x.dir[0][j], x.dir[1][j], x.dir[2][j]);
-            x.next.push_back(x.hit_path[j]);
-        }
-        // The round's shadow rays, in path order: their contributions come before the emission
-        // the next round adds, as in Li.
+        // Stage 4: the round's shadow rays. Each path has at most one, and its contribution
+        // comes before the emission the next round adds, as in Li.
         for (const uint32_t i : x.shadowed) {
             StagedPath<S>& p = paths[i];
             if (!sc.accel->occluded(p.shadow)) p.L += p.shadow_L;
@@ -376,64 +359,76 @@ inline bool staged_pass_applies(const Scene& scene, const Film& film) {
     // The lanes gather with 32-bit indices (3 floats per vertex and per triangle).
     constexpr size_t kMaxGathered = size_t(INT32_MAX) / 3;
     if (scene.mesh.positions.size() > kMaxGathered || scene.mesh.triangles.size() > kMaxGathered) return false;
-    return !film.weighted() && !film.adaptive() && film.aov_channels() == 0 && !film.has_alpha();
+    return !film.adaptive() && film.aov_channels() == 0 && !film.has_alpha();
 }
 
-// render_tiles (tiles.h) for an unweighted film, a tile's paths at a time through trace_staged.
+// render_tiles (tiles.h) with the paths of a tile's samples traced together by trace_staged: the
+// same samples, added to the film in the same order.
 template <class S>
 PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
                               const std::atomic<bool>* cancel, const S& prototype) {
-    const int w = film.width(), h = film.height();
-    const int tiles_x = (w + kTileSize - 1) / kTileSize;
-    const int tiles_y = (h + kTileSize - 1) / kTileSize;
-    const int n_tiles = tiles_x * tiles_y;
-    Camera camera = scene.camera;
-    camera.set_film_size(w, h);
-    std::atomic<uint64_t> total_rays{0}, total_samples{0};
-    std::atomic<bool> stopped{false};
+    detail::TilePass pass(scene, film, cancel);
+    const Camera& camera = pass.camera;
     const StagedTables tables(scene);
-#pragma omp parallel num_threads(n_threads)
-    {
+    struct Scratch {
         std::vector<StagedPath<S>> paths;
         std::vector<uint32_t> live;
-        StagedScratch scratch;
-#pragma omp for schedule(dynamic, 1)
-        for (int tile = 0; tile < n_tiles; ++tile) {
-            if (stopped.load(std::memory_order_relaxed)) continue;
-            if (cancel && cancel->load(std::memory_order_relaxed)) {
-                stopped = true;
-                continue;
-            }
+        std::vector<vec2> pos;  // weighted film: each path's film position
+        StagedScratch staged;
+    };
+    std::vector<Scratch> scratch(size_t(std::max(1, n_threads)));
+    // One path per pixel sample, in the scalar loop's order (pixel by pixel, samples s0..s1 - 1).
+    auto start = [&](Scratch& t, const detail::TileRange& tr, int s0, int s1) {
+        t.paths.clear();
+        t.live.clear();
+        t.pos.clear();
+        for (int y = tr.y0; y < tr.y1; ++y)
+            for (int x = tr.x0; x < tr.x1; ++x)
+                for (int s = s0; s < s1; ++s) {
+                    StagedPath<S> p{Ray(), vec3(0.f), vec3(1.f), vec3(0.f), 0.f, 1.f, true, prototype, Ray(), vec3(0.f)};
+                    p.sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
+                    const vec2 jitter = p.sampler.next_2d();
+                    const vec2 lens = camera.needs_lens_sample() ? p.sampler.next_2d() : vec2(0.5f);
+                    p.ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                    t.pos.push_back(vec2(float(x), float(y)) + jitter);
+                    t.live.push_back(uint32_t(t.paths.size()));
+                    t.paths.push_back(p);
+                }
+    };
+    if (!film.weighted()) {
+        pass.unweighted(n_threads, [&](const detail::TileRange& tr) {
+            Scratch& t = scratch[size_t(omp_get_thread_num())];
             PathStats ps;
-            const detail::TileRange tr = detail::tile_range(tile, tiles_x, w, h);
-            // One path per pixel sample, in the scalar loop's order (pixel by pixel, samples within).
-            paths.clear();
-            live.clear();
-            for (int y = tr.y0; y < tr.y1; ++y)
-                for (int x = tr.x0; x < tr.x1; ++x)
-                    for (int s = 0; s < spp; ++s) {
-                        StagedPath<S> p{Ray(), vec3(0.f), vec3(1.f), vec3(0.f), 0.f, 1.f, true, prototype, Ray(), vec3(0.f)};
-                        p.sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                        const vec2 jitter = p.sampler.next_2d();
-                        const vec2 lens = camera.needs_lens_sample() ? p.sampler.next_2d() : vec2(0.5f);
-                        p.ray = camera.generate_ray(ivec2(x, y), jitter, lens);
-                        live.push_back(uint32_t(paths.size()));
-                        paths.push_back(p);
-                    }
-            trace_staged(scene, tables, paths, live, scratch, ps);
+            start(t, tr, 0, spp);
+            trace_staged(scene, tables, t.paths, t.live, t.staged, ps);
             size_t k = 0;
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x)
-                    for (int s = 0; s < spp; ++s) film.add_sample(ivec2(x, y), paths[k++].L);
-            total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
-            total_samples.fetch_add(paths.size(), std::memory_order_relaxed);
-        }
+                    for (int s = 0; s < spp; ++s) film.add_sample(ivec2(x, y), t.paths[k++].L);
+            pass.add(ps.rays, t.paths.size());
+        });
+    } else {
+        const PixelFilter filter(scene.settings.filter);
+        pass.weighted(film, filter.reach(), spp, n_threads, [&](const detail::TileRange& tr, int s, FilmTile& ft) {
+            Scratch& t = scratch[size_t(omp_get_thread_num())];
+            PathStats ps;
+            start(t, tr, s, s + 1);
+            trace_staged(scene, tables, t.paths, t.live, t.staged, ps);
+            size_t k = 0;
+            for (int y = tr.y0; y < tr.y1; ++y)
+                for (int x = tr.x0; x < tr.x1; ++x, ++k) {
+                    vec3 L = t.paths[k].L;
+                    if (!all_finite(L)) {
+                        film.count_nonfinite();
+                        L = vec3(0.f);
+                    }
+                    film.count_sample(ivec2(x, y));
+                    detail::splat(ft, filter, pass.w, pass.h, t.pos[k], L, nullptr);
+                }
+            pass.add(ps.rays, t.paths.size());
+        });
     }
-    PassStats out;
-    out.rays = total_rays.load();
-    out.samples = total_samples.load();
-    out.completed = !stopped.load();
-    return out;
+    return pass.stats();
 }
 
 }  // namespace candela
