@@ -87,6 +87,16 @@ TEST(Staged, WeightedFilmsWithTheScenesFilter) {
     expect_same_films(*s, 36, 20, 2, 2, 36 * 20 / 2, "cornell box, lanczos radius 3", true);
 }
 
+TEST(Staged, ManySamplesPerPassGoInChunks) {
+    // 37 samples per pixel in one pass: batches of at most 4096 paths, 16 samples of a full tile
+    // at a time (16 + 16 + 5), each pixel's samples still in index order.
+    SceneOverrides ov;
+    ov.width = 20;
+    ov.height = 18;
+    std::shared_ptr<const Scene> box = prepare_scene("", ov);
+    expect_same_films(*box, 20, 18, 37, 2, 20 * 18 * 9 / 10, "37 samples per pixel in one pass");
+}
+
 TEST(Staged, HiddenEmittersAndOneThread) {
     SceneOverrides ov;
     ov.width = 20;

@@ -396,16 +396,25 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
                 }
     };
     if (!film.weighted()) {
+        // A batch holds at most kMaxBatch paths (a pass of many samples per pixel goes in chunks of
+        // samples): each pixel still gets its samples in index order, which is all its sums see.
+        constexpr int kMaxBatch = 4096;
+        const int chunk = std::max(1, kMaxBatch / (kTileSize * kTileSize));
         pass.unweighted(n_threads, [&](const detail::TileRange& tr) {
             Scratch& t = scratch[size_t(omp_get_thread_num())];
             PathStats ps;
-            start(t, tr, 0, spp);
-            trace_staged(scene, tables, t.paths, t.live, t.staged, ps);
-            size_t k = 0;
-            for (int y = tr.y0; y < tr.y1; ++y)
-                for (int x = tr.x0; x < tr.x1; ++x)
-                    for (int s = 0; s < spp; ++s) film.add_sample(ivec2(x, y), t.paths[k++].L);
-            pass.add(ps.rays, t.paths.size());
+            uint64_t samples = 0;
+            for (int s0 = 0; s0 < spp; s0 += chunk) {
+                const int s1 = std::min(spp, s0 + chunk);
+                start(t, tr, s0, s1);
+                trace_staged(scene, tables, t.paths, t.live, t.staged, ps);
+                size_t k = 0;
+                for (int y = tr.y0; y < tr.y1; ++y)
+                    for (int x = tr.x0; x < tr.x1; ++x)
+                        for (int s = s0; s < s1; ++s) film.add_sample(ivec2(x, y), t.paths[k++].L);
+                samples += t.paths.size();
+            }
+            pass.add(ps.rays, samples);
         });
     } else {
         const PixelFilter filter(scene.settings.filter);
