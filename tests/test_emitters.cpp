@@ -24,6 +24,7 @@
 #include "scene/camera.h"
 #include "sampling/warp.h"
 #include "scene/scene.h"
+#include "support/furnace.h"
 #include "support/load_error.h"
 #include "support/render.h"
 #include "support/run.h"
@@ -356,14 +357,7 @@ TEST(Emitters, LightChoiceIsUniformOverAreaLightsAndOthers) {
 namespace {
 
 std::shared_ptr<const Scene> furnace_scene(IntegratorType type, SamplingMode mode, int es, int bs) {
-    SceneDescription d;
-    d.source = "<white furnace>";
-    d.materials.push_back({"white", DiffuseBsdf{vec3(1.f)}, false});
-    d.add_analytic_shape("ball", make_sphere(mat4(1.f), vec3(0.f), 1.f, false), 0, -1);
-    d.lights.push_back({"sky", ConstantLight{vec3(1.f)}});
-    d.camera.to_world = look_at(vec3(0, 0, 4), vec3(0.f), vec3(0, 1, 0));
-    d.camera.fov_deg = 40.f;
-    d.settings.width = d.settings.height = 16;
+    SceneDescription d = candela::test::sphere_under_sky(1.f);
     d.settings.sampling = mode;
     d.settings.integrator.type = type;
     d.settings.integrator.emitter_samples = es;

@@ -10,6 +10,7 @@
 #include "scene/loaders.h"
 #include "integrator/sampled_pass.h"
 #include "render/launch.h"
+#include "support/furnace.h"
 
 using namespace candela;
 
@@ -240,15 +241,7 @@ TEST(Staged, HitReconstructionInLanesMatchesScene) {
 TEST(Staged, AnalyticShapesAndAnInfiniteLight) {
     // No mesh at all (an analytic sphere) and a light that is not an emissive triangle: hits are
     // reconstructed per path and light samples drawn per path, still in the staged rounds.
-    SceneDescription d;
-    d.source = "<staged furnace>";
-    d.materials.push_back({"grey", DiffuseBsdf{vec3(0.7f)}, false});
-    d.add_analytic_shape("ball", make_sphere(mat4(1.f), vec3(0.f), 1.f, false), 0, -1);
-    d.lights.push_back({"sky", ConstantLight{vec3(1.f)}});
-    d.camera.to_world = look_at(vec3(0, 0, 4), vec3(0.f), vec3(0, 1, 0));
-    d.camera.fov_deg = 40.f;
-    d.settings.width = d.settings.height = 16;
-    auto sc = build_scene(std::move(d));
+    auto sc = build_scene(candela::test::sphere_under_sky(0.7f));
     ASSERT_TRUE(sc->mesh.positions.empty());
     expect_same_films(*sc, 16, 16, 3, 2, 16 * 16, "analytic sphere, constant light");
 }

@@ -4,10 +4,13 @@
 # and whether the images agree within Monte Carlo noise (../shared/tools/imgcmp.py).
 #
 # Usage: bash bench/mitsuba/compare.sh [SCENE.xml] [--res N] [--spp N] [--max-depth M] [--threads T]
-#                                      [--embree-build DIR]
+#                                      [--rounds R] [--embree-build DIR]
 #   SCENE defaults to scenes/cornell-box/scene.xml. Each -D goes only to a scene that declares it
 #   (a published scene keeps its own size or depth when it has no parameter for them); --max-depth is MITSUBA's max_depth (path
 #   segments; candela gets M - 1 through the XML); default 8, i.e. 7 scattering events.
+#   --rounds R: candela and Mitsuba llvm rendered in turn R times (scalar once), each round's ratio
+#   and their median printed: this machine is shared, and one run can be 10-30% slow for reasons
+#   outside either program.
 #   --embree-build DIR: a build configured with -DCANDELA_EMBREE=ON; its candela renders the scene
 #   with the k-d tree and with Embree, in turn, and the ratio says how much of the distance to
 #   Mitsuba is the accelerator's (bench/RESULTS.md, "A mesh scene").
@@ -15,7 +18,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 scene=scenes/cornell-box/scene.xml
-res=256 spp=256 depth=8 threads=2 embree_build=
+res=256 spp=256 depth=8 threads=2 embree_build= rounds=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --res) res=$2; shift 2 ;;
@@ -23,6 +26,7 @@ while [ $# -gt 0 ]; do
     --max-depth) depth=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --embree-build) embree_build=$2; shift 2 ;;
+    --rounds) rounds=$2; shift 2 ;;
     -*) echo "compare.sh: unknown option $1" >&2; exit 2 ;;
     *) scene=$1; shift ;;
   esac
@@ -47,17 +51,32 @@ render() {
 }
 rate() { sed -n "s/.* \([0-9.]*\) $1\/s.*/\1/p"; }  # a rate from a summary line: Msamples or Mrays
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN{printf "%.2f", a / b}'; }
-c_line=$(render build/bin/candela "$out/candela.exr")
-c_sps=$(echo "$c_line" | rate Msamples)
-echo "candela:            $c_sps Msamples/s ($(echo "$c_line" | rate Mrays) Mrays/s)"
-for variant in scalar_rgb llvm_ad_rgb; do
-  "$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant $variant --spp "$spp" --threads "$threads" \
-        --warmup --out "$out/mitsuba_$variant.exr" > "$out/mitsuba_$variant.log" 2>&1
+# mitsuba VARIANT: renders the scene, prints Mitsuba's samples/s in millions.
+mitsuba() {
+  "$PY" $shared/mitsuba_render.py "$scene" "${defs[@]}" --variant "$1" --spp "$spp" --threads "$threads" \
+        --warmup --out "$out/mitsuba_$1.exr" > "$out/mitsuba_$1.log" 2>&1
   # The tool writes its timings next to the image as JSON (samples_per_s excludes load and warm-up).
-  sps=$("$PY" -c 'import json, sys; print("%.3f" % (json.load(open(sys.argv[1]))["samples_per_s"] / 1e6))' \
-        "$out/mitsuba_$variant.json")
-  echo "mitsuba $variant: $sps Msamples/s   candela/mitsuba = $(ratio "$c_sps" "$sps")"
+  "$PY" -c 'import json, sys; print("%.3f" % (json.load(open(sys.argv[1]))["samples_per_s"] / 1e6))' \
+        "$out/mitsuba_$1.json"
+}
+ratios=()
+for round in $(seq "$rounds"); do
+  tag=$([ "$rounds" -gt 1 ] && echo " (round $round)" || true)
+  c_line=$(render build/bin/candela "$out/candela.exr")
+  c_sps=$(echo "$c_line" | rate Msamples)
+  echo "candela$tag:            $c_sps Msamples/s ($(echo "$c_line" | rate Mrays) Mrays/s)"
+  for variant in scalar_rgb llvm_ad_rgb; do
+    [ "$variant" = scalar_rgb ] && [ "$round" -gt 1 ] && continue
+    sps=$(mitsuba $variant)
+    echo "mitsuba $variant$tag: $sps Msamples/s   candela/mitsuba = $(ratio "$c_sps" "$sps")"
+  done
+  ratios+=("$(ratio "$c_sps" "$sps")")
 done
+if [ "$rounds" -gt 1 ]; then
+  printf '%s\n' "${ratios[@]}" | sort -n | awk '{r[NR] = $1} END {
+    m = NR % 2 ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2
+    printf "candela/mitsuba llvm_ad_rgb over %d alternating rounds: median %.2f (min %.2f, max %.2f)\n", NR, m, r[1], r[NR] }'
+fi
 if [ -n "$embree_build" ]; then
   # The same binary with each accelerator, alternated twice (the machine's noise is +-10%).
   for round in 1 2; do
