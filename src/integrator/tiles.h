@@ -175,6 +175,17 @@ private:
 
 }  // namespace detail
 
+// A camera sample of pixel (x, y) with sample index `index`: the sampler seeded for them, then its
+// first dimensions, the pixel jitter (2, uniform over the pixel) and the lens (2, a thin lens with
+// an aperture only); the integrator's follow. `jitter` gets the position in the pixel.
+template <class S>
+inline Ray camera_sample(S& sampler, const Camera& camera, int x, int y, uint32_t index, vec2& jitter) {
+    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), index);
+    jitter = sampler.next_2d();
+    const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+    return camera.generate_ray(ivec2(x, y), jitter, lens);
+}
+
 // The sampler of a pass over `film`: the scene's, its seed and sample_count, and the range of the
 // sampler pixels (the film's pixels shifted by a crop window's offset).
 inline SamplerSetup sampler_setup(const Scene& scene, const Film& film) {
@@ -211,12 +222,8 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
                 for (int x = tr.x0; x < tr.x1; ++x) {
                     if (adaptive && !film.active(x, y)) continue;
                     for (int s = 0; s < spp; ++s) {
-                        // Sampler dimensions of a camera sample: the pixel jitter (2), the lens (2, a
-                        // thin lens with an aperture only), then the integrator's.
-                        sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                        vec2 jitter = sampler.next_2d();  // uniform over the pixel
-                        vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
-                        Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                        vec2 jitter;
+                        Ray ray = camera_sample(sampler, camera, x, y, first_sample + uint32_t(s), jitter);
                         if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
                         const uint64_t hits = ps.camera_hits;
                         vec3 L = li(sampler, ray, ps);
@@ -243,12 +250,10 @@ PassStats render_tiles(const Scene& scene, Film& film, uint32_t first_sample, in
             float aov[64];
             for (int y = tr.y0; y < tr.y1; ++y)
                 for (int x = tr.x0; x < tr.x1; ++x) {
-                    sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                    const vec2 jitter = sampler.next_2d();
-                    const vec2 lens = camera.needs_lens_sample() ? sampler.next_2d() : vec2(0.5f);
+                    vec2 jitter;
+                    Ray ray = camera_sample(sampler, camera, x, y, first_sample + uint32_t(s), jitter);
                     // The filter works in this film's pixels (a crop window only shifts them).
                     const vec2 pos = vec2(float(x), float(y)) + jitter;
-                    Ray ray = camera.generate_ray(ivec2(x, y), jitter, lens);
                     if (n_aov > 0) eval_aovs(scene, aovs, eye, ray, aov, &ps.rays);
                     const uint64_t hits = ps.camera_hits;
                     vec3 L = li(sampler, ray, ps);

@@ -386,10 +386,8 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
             for (int x = tr.x0; x < tr.x1; ++x)
                 for (int s = s0; s < s1; ++s) {
                     StagedPath<S> p{Ray(), vec3(0.f), vec3(1.f), vec3(0.f), 0.f, 1.f, true, prototype, Ray(), vec3(0.f)};
-                    p.sampler.start_pixel_sample(camera.sampler_pixel(ivec2(x, y)), first_sample + uint32_t(s));
-                    const vec2 jitter = p.sampler.next_2d();
-                    const vec2 lens = camera.needs_lens_sample() ? p.sampler.next_2d() : vec2(0.5f);
-                    p.ray = camera.generate_ray(ivec2(x, y), jitter, lens);
+                    vec2 jitter;
+                    p.ray = camera_sample(p.sampler, camera, x, y, first_sample + uint32_t(s), jitter);
                     t.pos.push_back(vec2(float(x), float(y)) + jitter);
                     t.live.push_back(uint32_t(t.paths.size()));
                     t.paths.push_back(p);
