@@ -24,8 +24,7 @@ void expect_same_films(const Scene& scene, int w, int h, int spp, int threads, i
     if (weighted) a.set_layout(true, 0), b.set_layout(true, 0);
     ASSERT_TRUE(staged_pass_applies(scene, b)) << what;
     PassStats pa = render_sampled_pass<PathIntegrator>(scene, a, 0, spp, threads, nullptr);
-    PassStats pb = render_tiles_staged(scene, b, 0, spp, threads, nullptr,
-                                       make_sampler<IndependentSampler>(sampler_setup(scene, b)));
+    PassStats pb = render_staged_sampled_pass(scene, b, 0, spp, threads, nullptr);
     EXPECT_EQ(pa.rays, pb.rays) << what;
     EXPECT_EQ(pa.samples, pb.samples) << what;
     int lit = 0;
@@ -96,6 +95,25 @@ TEST(Staged, ManySamplesPerPassGoInChunks) {
     ov.height = 18;
     std::shared_ptr<const Scene> box = prepare_scene("", ov);
     expect_same_films(*box, 20, 18, 37, 2, 20 * 18 * 9 / 10, "37 samples per pixel in one pass");
+}
+
+TEST(Staged, EverySampler) {
+    // Each path's sampler is a copy of the pass's prototype, seeded per pixel sample: the numbers
+    // are those of the per-path loop's one sampler per tile, for every sampler type.
+    SceneOverrides ov;
+    ov.width = 24;
+    ov.height = 20;
+    std::shared_ptr<const Scene> box = prepare_scene("", ov);
+    const SamplerType types[] = {SamplerType::Independent, SamplerType::Stratified, SamplerType::Multijitter,
+                                 SamplerType::LdSampler,   SamplerType::Sobol,      SamplerType::ZSobol,
+                                 SamplerType::Orthogonal};
+    for (SamplerType t : types) {
+        SceneParams p = box->params();
+        p.settings.sampler.type = t;
+        p.settings.spp = 16;
+        std::shared_ptr<const Scene> s = box->with_params(p);
+        expect_same_films(*s, 24, 20, 4, 2, 24 * 20 / 2, ("sampler " + std::to_string(int(t))).c_str());
+    }
 }
 
 TEST(Staged, HiddenEmittersAndOneThread) {

@@ -10,15 +10,14 @@ namespace candela {
 PassStats PathPass::render_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp, int threads,
                                 const std::atomic<bool>* cancel) const {
     // The staged loop (integrator/path/wavefront.h) where it applies: the same image, bit for bit,
-    // with hit reconstruction, light samples and the diffuse step in SIMD lanes.
+    // with the diffuse hits' reconstruction, shading, light samples and BSDF samples in SIMD lanes.
     // CANDELA_STAGED=0 keeps the per-path loop (for A/B measurements).
     static const bool staged = [] {
         const char* v = std::getenv("CANDELA_STAGED");
         return !(v && v[0] == '0');
     }();
-    if (staged && scene.settings.sampler.type == SamplerType::Independent && staged_pass_applies(scene, film))
-        return render_tiles_staged(scene, film, first_sample, spp, threads, cancel,
-                                   make_sampler<IndependentSampler>(sampler_setup(scene, film)));
+    if (staged && staged_pass_applies(scene, film))
+        return render_staged_sampled_pass(scene, film, first_sample, spp, threads, cancel);
     return render_sampled_pass<PathIntegrator>(scene, film, first_sample, spp, threads, cancel);
 }
 

@@ -18,9 +18,9 @@
 // film gets the samples in the scalar loop's order: the image is the same bit for bit
 // (tests/test_staged.cpp compares the films on every SIMD target).
 //
-// Scope (staged_pass_applies): scenes without masks or textured emitters, the independent
-// sampler, films without adaptive sampling, AOVs or alpha (any pixel filter). The path pass uses
-// the per-path loop otherwise, and with CANDELA_STAGED=0.
+// Scope (staged_pass_applies): scenes without masks or textured emitters, any sampler, films
+// without adaptive sampling, AOVs or alpha (any pixel filter). The path pass uses the per-path
+// loop otherwise, and with CANDELA_STAGED=0.
 #include <climits>
 #include <vector>
 #include "integrator/path.h"
@@ -436,6 +436,48 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
         });
     }
     return pass.stats();
+}
+
+// The staged pass with the scene's sampler. Every sampler's numbers after start_pixel_sample
+// depend only on (pixel, index, seed) (sampling/samplers.h), so a copy of the prototype per path
+// draws what the per-path loop's one sampler per tile draws. The independent sampler's loop is
+// instantiated where this is called; the others each in integrator/samplers/path_<sampler>.cpp,
+// as the per-path loop's are (integrator/sampled_pass.h).
+template <class S>
+PassStats render_staged_for(const Scene& scene, Film& film, uint32_t first_sample, int spp, int n_threads,
+                            const std::atomic<bool>* cancel) {
+    return render_tiles_staged(scene, film, first_sample, spp, n_threads, cancel,
+                               make_sampler<S>(sampler_setup(scene, film)));
+}
+#define CANDELA_STAGED_EXTERN(S)                                                                           \
+    extern template PassStats render_staged_for<S>(const Scene&, Film&, uint32_t, int, int,             \
+                                                   const std::atomic<bool>*);
+CANDELA_STAGED_EXTERN(StratifiedSampler)
+CANDELA_STAGED_EXTERN(MultijitterSampler)
+CANDELA_STAGED_EXTERN(LdSampler)
+CANDELA_STAGED_EXTERN(SobolSampler)
+CANDELA_STAGED_EXTERN(ZSobolSampler)
+CANDELA_STAGED_EXTERN(OrthogonalSampler)
+#undef CANDELA_STAGED_EXTERN
+
+inline PassStats render_staged_sampled_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp,
+                                            int n_threads, const std::atomic<bool>* cancel) {
+    switch (scene.settings.sampler.type) {
+        case SamplerType::Stratified:
+            return render_staged_for<StratifiedSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::Multijitter:
+            return render_staged_for<MultijitterSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::LdSampler:
+            return render_staged_for<LdSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::Sobol:
+            return render_staged_for<SobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::ZSobol:
+            return render_staged_for<ZSobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::Orthogonal:
+            return render_staged_for<OrthogonalSampler>(scene, film, first_sample, spp, n_threads, cancel);
+        case SamplerType::Independent: break;
+    }
+    return render_staged_for<IndependentSampler>(scene, film, first_sample, spp, n_threads, cancel);
 }
 
 }  // namespace candela
