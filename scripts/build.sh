@@ -18,6 +18,11 @@ for a in "$@"; do
     *) echo "build.sh: unknown option '$a'" >&2; exit 2 ;;
   esac
 done
+# CANDELA_CCACHE=1: compile through ccache (developers' worktrees and clones share objects: no
+# object depends on the checkout's path; set CCACHE_BASEDIR to the folder that holds them).
+if [ "${CANDELA_CCACHE:-0}" = 1 ] && command -v ccache >/dev/null; then
+  extra+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+fi
 if [ ! -f "$dir/build.ninja" ]; then
   cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" "${extra[@]}" >/dev/null
 elif [ "${#extra[@]}" -gt 0 ]; then

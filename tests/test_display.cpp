@@ -286,9 +286,9 @@ TEST(Display, DrawsIntoSubRectangleAndRestoresState) {
 
 TEST(Display, EmbeddedShadersMatchTheSourceTree) {
     for (const char* name : {"display.vert", "display.frag"}) {
-        const auto file = candela::load_display_shader(CANDELA_SHADER_DIR, name);
+        const auto file = candela::load_display_shader(candela::default_shader_dir(), name);
         const auto embedded = candela::load_display_shader("", name);
-        EXPECT_EQ(file.origin, std::string(CANDELA_SHADER_DIR) + "/" + name);
+        EXPECT_EQ(file.origin, std::string(candela::default_shader_dir()) + "/" + name);
         EXPECT_EQ(embedded.origin, std::string("<embedded>/") + name);
         EXPECT_EQ(file.text, embedded.text) << "rerun cmake: the embedded copy of " << name << " is stale";
         // A missing shader directory falls back to the embedded copy.

@@ -140,7 +140,7 @@ TEST(DisplayFallback, UnusableDisplayRendersHeadless) {
 // scripts/run.sh, with stubs for setup.sh, build.sh and the program (which prints its arguments).
 TEST(RunScript, AddsOutOnlyWhenThereIsNone) {
     std::string d = temp_dir("run-sh");
-    ASSERT_EQ(std::system(("mkdir -p '" + d + "/scripts' '" + d + "/build/bin' && cp '" CANDELA_SOURCE_DIR
+    ASSERT_EQ(std::system(("mkdir -p '" + d + "/scripts' '" + d + "/build/bin' && cp '" + std::string(CANDELA_SOURCE_DIR) +
                            "/scripts/run.sh' '" + d + "/scripts/'").c_str()),
               0);
     write_text(d + "/scripts/setup.sh", "exit 0\n");

@@ -113,6 +113,8 @@ struct PixelStoreScope {
 
 }  // namespace
 
+const char* default_shader_dir() { return CANDELA_SHADER_DIR; }
+
 ShaderSource load_display_shader(const std::string& shader_dir, const std::string& name) {
     if (!shader_dir.empty()) {
         std::string path = shader_dir + "/" + name;

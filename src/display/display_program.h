@@ -20,13 +20,15 @@ struct ShaderSource {
     std::string text;
 };
 ShaderSource load_display_shader(const std::string& shader_dir, const std::string& name);
+// The source tree's shaders/ folder, as configured (compiled into display_program.cpp alone).
+const char* default_shader_dir();
 
 class DisplayProgram {
 public:
     // Compiles and links the shaders in the context current on this thread (GL 3.3 core or later)
     // using `gl`, a table loaded for that context. Throws Error with the shader file and the GL
     // info log on failure. The table is copied.
-    explicit DisplayProgram(const GlApi& gl, const std::string& shader_dir = CANDELA_SHADER_DIR);
+    explicit DisplayProgram(const GlApi& gl, const std::string& shader_dir = default_shader_dir());
     // Deletes the GL objects: the same context must still be current.
     ~DisplayProgram();
     DisplayProgram(const DisplayProgram&) = delete;

@@ -1,0 +1,15 @@
+#include "support/paths.h"
+
+namespace candela::test_paths {
+const char* bin() { return CANDELA_PATH_BIN; }
+const char* source_dir() { return CANDELA_PATH_SOURCE_DIR; }
+const char* test_data() { return CANDELA_PATH_TEST_DATA; }
+const char* shared_dir() { return CANDELA_PATH_SHARED_DIR; }
+const char* mpirun() {
+#ifdef CANDELA_PATH_MPIRUN
+    return CANDELA_PATH_MPIRUN;
+#else
+    return "mpiexec";
+#endif
+}
+}  // namespace candela::test_paths

@@ -1,0 +1,20 @@
+#pragma once
+// Where the tests find the program, the source tree and their data. The values are compiled into
+// one file (paths.cpp) rather than into every test's flags, so that an object file does not
+// depend on where the checkout lives (ccache can share objects between clones and worktrees).
+// Force-included into every test file by tests/CMakeLists.txt.
+#include <string>
+
+namespace candela::test_paths {
+const char* bin();          // the candela program
+const char* source_dir();   // the repository root
+const char* test_data();    // tests/data
+const char* shared_dir();   // ../shared (a development aid; never required)
+const char* mpirun();       // mpiexec, in a build with MPI
+}  // namespace candela::test_paths
+
+#define CANDELA_BIN (std::string(candela::test_paths::bin()))
+#define CANDELA_SOURCE_DIR (candela::test_paths::source_dir())
+#define CANDELA_TEST_DATA (candela::test_paths::test_data())
+#define CANDELA_SHARED_DIR (candela::test_paths::shared_dir())
+#define CANDELA_MPIRUN (candela::test_paths::mpirun())
