@@ -11,7 +11,6 @@
 #include "render/renderer.h"
 #include "sampling/pcg32.h"
 #include "scene/scene.h"
-#include "support/shared_assets.h"
 #include "support/render.h"
 #include "support/stats.h"
 
@@ -153,8 +152,7 @@ std::string load_error(const std::string& path) {
 }  // namespace
 
 TEST(Instancing, MemoryGrowsWithInstancesNotTriangles) {
-    const std::string bunny = test::shared_mesh_path("bunny.obj");
-    CANDELA_REQUIRE_SHARED_MESH(bunny);
+    const std::string bunny = test_paths::asset("meshes/bunny.obj");
     size_t total[4], tris[4];
     const int counts[4] = {1, 10, 100, 1000};
     for (int c = 0; c < 4; ++c) {

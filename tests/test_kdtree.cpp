@@ -1,7 +1,7 @@
 // The k-d tree and the hybrid grid against the brute-force oracle: the same closest t, bit for bit
 // (the triangle may differ only where t ties), and the same any-hit answer, on random triangle
-// soups and on the scanned meshes in ../shared (skipped when absent, failed under CI=true), 100k rays in all (fewer on the
-// big meshes, where brute force is slow); plus watertightness: rays
+// soups and on the scanned meshes in assets/meshes, 100k rays in all (fewer on the big meshes,
+// where brute force is slow); plus watertightness: rays
 // aimed exactly at shared edges and vertices of closed and tessellated meshes always hit.
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
@@ -17,7 +17,6 @@
 #include "accel/kdtree.h"
 #include "geometry/triangle.h"
 #include "sampling/pcg32.h"
-#include "support/shared_assets.h"
 
 using namespace candela;
 
@@ -261,7 +260,7 @@ void check_all(const Mesh& m, size_t nrays, uint64_t seed, const std::string& wh
     expect_matches(grid_fine, m, rays, ref, what + " (fine grid)");
 }
 
-std::string shared_mesh(const char* name) { return candela::test::shared_mesh_path(name); }
+std::string asset_mesh(const char* name) { return candela::test_paths::asset(std::string("meshes/") + name); }
 
 // Icosahedron subdivided `levels` times with shared vertices: a closed, watertight sphere.
 Mesh icosphere(int levels, vec3 center, float radius) {
@@ -371,8 +370,7 @@ TEST(KdTree, TeapotInStadiumMatchesBruteForce) { check_all(clustered_soup(3000, 
 
 TEST(KdTree, BunnyMatchesBruteForce) {
     Mesh m;
-    CANDELA_REQUIRE_SHARED_MESH(shared_mesh("bunny.obj"));
-    ASSERT_TRUE(load_obj(shared_mesh("bunny.obj"), m));
+    ASSERT_TRUE(load_obj(asset_mesh("bunny.obj"), m)) << asset_mesh("bunny.obj");
     check_all(m, 6000, 3, "bunny");
 }
 
@@ -381,8 +379,7 @@ TEST(KdTree, BunnyMatchesBruteForce) {
 // must still be brute force's, and a tree that is one leaf keeps its single lane.
 TEST(KdTree, LeavesSplitIntoLanesMatchBruteForce) {
     Mesh m;
-    CANDELA_REQUIRE_SHARED_MESH(shared_mesh("bunny.obj"));
-    ASSERT_TRUE(load_obj(shared_mesh("bunny.obj"), m));
+    ASSERT_TRUE(load_obj(asset_mesh("bunny.obj"), m)) << asset_mesh("bunny.obj");
     std::vector<Ray> rays = make_rays(m, 6000, 11);
     Reference ref = brute_force(m, rays);
     for (float ki : {0.02f, 0.1f}) {
@@ -441,8 +438,7 @@ TEST(KdTree, OneLeafRoomSplitIntoLanesMatchesBruteForce) {
 
 TEST(KdTree, DragonMatchesBruteForce) {
     Mesh m;
-    CANDELA_REQUIRE_SHARED_MESH(shared_mesh("dragon_100k.obj"));
-    ASSERT_TRUE(load_obj(shared_mesh("dragon_100k.obj"), m));
+    ASSERT_TRUE(load_obj(asset_mesh("dragon_100k.obj"), m)) << asset_mesh("dragon_100k.obj");
     check_all(m, 4000, 4, "dragon");
 }
 
@@ -452,13 +448,8 @@ TEST(KdTree, CoherentOriginsMatchBruteForce) {
     std::vector<std::pair<std::string, Mesh>> meshes;
     meshes.emplace_back("random soup", random_soup(3000, 5));
     for (const char* name : {"bunny.obj", "dragon_100k.obj"}) {
-        // Without ../shared the soup alone is checked (a failure under CI).
-        if (!std::ifstream(shared_mesh(name))) {
-            if (candela::test::running_under_ci()) ADD_FAILURE() << shared_mesh(name) << " is absent, and CI=true";
-            continue;
-        }
         Mesh m;
-        ASSERT_TRUE(load_obj(shared_mesh(name), m)) << name;
+        ASSERT_TRUE(load_obj(asset_mesh(name), m)) << name;
         meshes.emplace_back(name, std::move(m));
     }
     for (const auto& [what, m] : meshes) {

@@ -530,7 +530,7 @@ TEST(MeshFiles, PublicScenesMeshesMatchWhatMitsubaReads) {
         for (uint32_t& x : f) ss >> x;
         ASSERT_TRUE(ss) << line;
         SCOPED_TRACE(path + "@" + std::to_string(index));
-        std::string full = std::string(CANDELA_SHARED_DIR) + "/scenes-public/" + path;
+        std::string full = candela::test_paths::asset("scenes-public/" + path);
         MeshFile m = path.size() > 4 && path.substr(path.size() - 4) == ".ply" ? read_ply(full) : read_serialized(full, index);
         ASSERT_EQ(m.positions.size(), nv);
         ASSERT_EQ(m.triangles.size(), nf);
@@ -796,7 +796,7 @@ stats::ImageEstimate load_estimate(const std::string& prefix) { return stats::Im
 
 stats::ImageEstimate render_mesh_scene(const std::function<void(SceneDescription&)>& edit) {
     SceneDescription desc = load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/mesh_formats.xml",
-                                       {{"shared", CANDELA_SHARED_DIR}, {"res", "64"}});
+                                       {{"res", "64"}});
     edit(desc);
     const std::shared_ptr<const Scene> built = build_scene(std::move(desc));
     std::vector<std::unique_ptr<Film>> films;

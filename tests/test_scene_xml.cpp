@@ -7,7 +7,6 @@
 #include "core/error.h"
 #include "scene/cornell.h"
 #include "scene/loaders.h"
-#include "support/shared_assets.h"
 
 using namespace candela;
 
@@ -564,12 +563,11 @@ TEST(SceneXml, EveryShippedSceneLoads) {
     EXPECT_FLOAT_EQ(alphas[3], 0.2f);
 }
 
-// The benchmarks' mesh scene (bench/RESULTS.md): the XML box with the shared bunny in place of its
-// blocks.
+// The benchmarks' mesh scene (bench/RESULTS.md): the XML box with the bunny of assets/meshes in
+// place of its blocks, found by the scene's own relative path.
 TEST(SceneXml, BenchMeshSceneLoads) {
-    CANDELA_REQUIRE_SHARED_MESH(test::shared_mesh_path("bunny.obj"));
     SceneDescription s = load_mitsuba_xml(std::string(CANDELA_SOURCE_DIR) + "/bench/scenes/cornell-bunny.xml",
-                                          {{"shared", test::shared_dir()}, {"res", "16"}});
+                                          {{"res", "16"}});
     EXPECT_NO_THROW(build_scene(s));
     EXPECT_EQ(s.mesh.triangles.size(), 69463u);  // the bunny's 69,451, the walls' 10 and the light's 2
     EXPECT_EQ(s.emitters.size(), 1u);

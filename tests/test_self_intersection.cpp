@@ -5,7 +5,7 @@
 // rejects t inside its own rounding bound. Together they must keep a spawned ray off its own
 // triangle in every direction, at every scale and offset. We check it on random triangles (general
 // position, tiny, huge, far from the origin, axis-aligned with the plane coordinate exactly 0 or
-// 1e5, slivers) and on the Stanford bunny when the shared assets are present:
+// 1e5, slivers) and on the Stanford bunny (assets/meshes):
 //   * spawn_ray in random directions on both sides of the surface;
 //   * spawn_ray_to towards random points (including points on the start triangle's own plane side
 //     and on other triangles), where the shadow ray must also not report the target's triangle.
@@ -17,7 +17,6 @@
 #include <gtest/gtest.h>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include "geometry/analytic.h"
 #include "geometry/triangle.h"
@@ -25,7 +24,6 @@
 #include "sampling/warp.h"
 #include "scene/obj.h"
 #include "scene/scene.h"
-#include "support/shared_assets.h"
 
 using namespace candela;
 
@@ -213,8 +211,7 @@ TEST(SelfIntersection, RandomTrianglesNeverHitThemselves) {
 // The same property on a real mesh, through the whole scene as well: the closest hit of a spawned
 // ray is never its own triangle (neighbours sharing an edge may legitimately be hit).
 TEST(SelfIntersection, BunnyNeverHitsItself) {
-    const std::string path = candela::test::shared_mesh_path("bunny.obj");
-    CANDELA_REQUIRE_SHARED_MESH(path);
+    const std::string path = candela::test_paths::asset("meshes/bunny.obj");
     ObjData obj = read_obj(path, false);
     std::vector<uvec3> tris;
     for (const ObjGroup& g : obj.groups) tris.insert(tris.end(), g.triangles.begin(), g.triangles.end());

@@ -74,7 +74,7 @@ TEST(Staged, SameFilmAsThePerPathLoop) {
 TEST(Staged, WeightedFilmsWithTheScenesFilter) {
     // Gaussian (matpreview's own) and a wide Lanczos: samples splat across tiles, one sample index
     // at a time, on one and two threads.
-    auto mp = build_scene(load_scene(std::string(CANDELA_SHARED_DIR) + "/scenes-public/mdata_matpreview/matpreview.xml"));
+    auto mp = build_scene(load_scene(candela::test_paths::asset("scenes-public/mdata_matpreview/matpreview.xml")));
     ASSERT_FALSE(mp->settings.filter.is_box());
     expect_same_films(*mp, 40, 24, 3, 2, 40 * 24 / 2, "matpreview, its gaussian filter", true);
     SceneOverrides ov;
@@ -153,7 +153,7 @@ TEST(Staged, OtherMaterialsPerPathInTheSameRounds) {
     // Glossy, rough, specular, layered and textured materials (their bounces made per path in the
     // rounds), beside untextured diffuse ones in lanes; lights that are triangles, spheres, a
     // point, an environment map and a constant.
-    const std::string src = CANDELA_SOURCE_DIR, shared = std::string(CANDELA_SHARED_DIR) + "/scenes-public/";
+    const std::string src = CANDELA_SOURCE_DIR, pub = candela::test_paths::asset("scenes-public/");
     struct Case {
         std::string file;
         int lit_mis, lit_bsdf;  // pixels that must be lit (-1: mode not tried: a point light only)
@@ -161,11 +161,11 @@ TEST(Staged, OtherMaterialsPerPathInTheSameRounds) {
     const Case cases[] = {{src + "/scenes/cornell-materials/glossy-glass.xml", 24 * 20 / 2, 5},
                           {src + "/scenes/cornell-materials/mirror-glass.xml", 24 * 20 / 2, 5},
                           {src + "/scenes/cornell-materials/rough.xml", 24 * 20 / 2, 5},
-                          {shared + "tutorials_cbox/cbox.xml", 24 * 20 / 2, 5},
-                          {shared + "bitterli_veach_mis/scene.xml", 24 * 20 / 2, 5},
-                          {shared + "mdata_matpreview/matpreview.xml", 24 * 20 / 2, 24 * 20 / 2},
-                          {shared + "mdata_test_orthographic/test_orthographic_path.xml", 24 * 20 / 2, 24 * 20 / 2},
-                          {shared + "blender_export_test1/test1.xml", 20, -1}};
+                          {pub + "tutorials_cbox/cbox.xml", 24 * 20 / 2, 5},
+                          {pub + "bitterli_veach_mis/scene.xml", 24 * 20 / 2, 5},
+                          {pub + "mdata_matpreview/matpreview.xml", 24 * 20 / 2, 24 * 20 / 2},
+                          {pub + "mdata_test_orthographic/test_orthographic_path.xml", 24 * 20 / 2, 24 * 20 / 2},
+                          {pub + "blender_export_test1/test1.xml", 20, -1}};
     int textured = 0;
     for (const Case& c : cases) {
         auto sc = build_scene(load_scene(c.file));
@@ -246,7 +246,7 @@ TEST(Staged, HitReconstructionInLanesMatchesScene) {
     ov.height = 8;
     auto box = prepare_scene("", ov);
     // Smooth shading normals: matpreview's meshes.
-    auto mp = build_scene(load_scene(std::string(CANDELA_SHARED_DIR) + "/scenes-public/mdata_matpreview/matpreview.xml"));
+    auto mp = build_scene(load_scene(candela::test_paths::asset("scenes-public/mdata_matpreview/matpreview.xml")));
     struct Restore {
         ~Restore() { hwy::SetSupportedTargetsForTest(0); }
     } restore;

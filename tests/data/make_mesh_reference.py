@@ -4,14 +4,14 @@ serialized meshes (object space, no to_world), for test_mesh_formats to compare 
 against. One line per mesh:
   path shape_index vertices faces has_normals has_uv  bbox_min(3) bbox_max(3)
   v[0](3) v[n/2](3) v[n-1](3)  uv[0](2) uv[n-1](2)  face[0](3) face[last](3)
-path is relative to ../shared/scenes-public. Usage: $PY tests/data/make_mesh_reference.py
+path is relative to assets/scenes-public. Usage: $PY tests/data/make_mesh_reference.py
 """
 import os
 import numpy as np
 import mitsuba as mi
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-PUBLIC = os.path.normpath(os.path.join(HERE, "..", "..", "..", "shared", "scenes-public"))
+PUBLIC = os.path.normpath(os.path.join(HERE, "..", "..", "assets", "scenes-public"))
 MESHES = [
     ("mdata_hello_teapot/common/meshes/teapot.ply", 0),
     ("sionna_floor_wall/meshes/floor.ply", 0),

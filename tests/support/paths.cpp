@@ -4,7 +4,7 @@ namespace candela::test_paths {
 const char* bin() { return CANDELA_PATH_BIN; }
 const char* source_dir() { return CANDELA_PATH_SOURCE_DIR; }
 const char* test_data() { return CANDELA_PATH_TEST_DATA; }
-const char* shared_dir() { return CANDELA_PATH_SHARED_DIR; }
+const char* assets_dir() { return CANDELA_PATH_ASSETS_DIR; }
 const char* mpirun() {
 #ifdef CANDELA_PATH_MPIRUN
     return CANDELA_PATH_MPIRUN;
