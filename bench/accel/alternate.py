@@ -9,7 +9,7 @@ thread's CPU time (candela-bench --threads 1 reports it).
 usage: bench/accel/alternate.py MESH.obj RAYS.rays RUNS CONFIG [CONFIG ...]
   CONFIG: BENCH_BINARY[|ACCEL[|NAME=VALUE ...]]  (ACCEL defaults to kdtree; NAME=VALUE are set in
           the environment of that configuration's runs)
-example: bench/accel/alternate.py ../shared/assets/meshes/bunny.obj /tmp/accel/bunny_bounce.rays 4 \\
+example: bench/accel/alternate.py assets/meshes/bunny.obj /tmp/accel/bunny_bounce.rays 4 \\
              'build-accel/bin/candela-bench|kdtree' 'build-accel/bin/candela-bench|embree'
 """
 import os

@@ -14,7 +14,12 @@
 #   --embree-build DIR: a build configured with -DCANDELA_EMBREE=ON; its candela renders the scene
 #   with the k-d tree and with Embree, in turn, and the ratio says how much of the distance to
 #   Mitsuba is the accelerator's (bench/RESULTS.md, "A mesh scene").
-# Output goes to out/bench-mitsuba/. Needs ../shared/tools (setup-reference.sh installs Mitsuba).
+# Output goes to out/bench-mitsuba/.
+#
+# A developer aid, optional: it needs Mitsuba 3 and the reference tools of ../shared/tools
+# (setup-reference.sh, mitsuba_render.py, imgcmp.py), which live outside the repository. Nothing in
+# the repository needs it: no test or build step calls it. The scenes it renders are the
+# repository's (scenes/, bench/scenes/, assets/scenes-public/).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 scene=scenes/cornell-box/scene.xml
@@ -32,6 +37,10 @@ while [ $# -gt 0 ]; do
   esac
 done
 shared=../shared/tools
+if [ ! -f "$shared/setup-reference.sh" ]; then
+  echo "compare.sh: $shared (the Mitsuba 3 reference tools, a developer aid outside the repository) is absent" >&2
+  exit 1
+fi
 eval "$(bash $shared/setup-reference.sh --no-apt | grep '^PY=')"
 bash scripts/build.sh >/dev/null
 out=out/bench-mitsuba

@@ -5,7 +5,7 @@
         [--seeds 2] [--levels 64,256,1024] [--target 0] [--candela build/bin/candela]
 
 $PY is the reference venv's python (/root/.cache/candela-ref/venv/bin/python): Mitsuba 3 renders
-in this process through /work/shared/tools/mitsuba_render.py (llvm_ad_rgb, warm-up pass untimed,
+in this process through ../shared/tools/mitsuba_render.py (llvm_ad_rgb, warm-up pass untimed,
 so JIT compilation is not counted), candela as a subprocess (its summary line's render time, no
 start-up or loading). Scene (--scene): cornell, veach-mis or caustics (scenes/*/scene.xml) at
 width --res (height by the scene's aspect), unbounded depth, box filter;
@@ -35,7 +35,9 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from benchlib import read_pfm, run_candela  # noqa: E402
 
-TOOLS = "/work/shared/tools"
+# The Mitsuba 3 reference tools beside the repository: a developer aid outside it, needed by this
+# benchmark only (no test or build step runs it).
+TOOLS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "tools"))
 # name -> (XML, height / width): the XMLs take $width and $height (the Cornell box's $res sets both).
 XMLS = {"cornell": ("scenes/cornell-box/scene.xml", 1.0), "veach-mis": ("scenes/veach-mis/scene.xml", 2 / 3),
         "caustics": ("scenes/caustics/scene.xml", 0.75)}
