@@ -147,12 +147,12 @@ TEST(Adaptive, CliRefusesWhatItDoesNotSupport) {
     auto r = test::run_candela(base + "--sampler sobol");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("needs the independent sampler"), std::string::npos) << r.output;
-    r = test::run_candela(base + "--integrator ptracer");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("splats of ptracer and bdpt land anywhere"), std::string::npos) << r.output;
-    r = test::run_candela(base + "--integrator bdpt");
-    EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("splats of ptracer and bdpt land anywhere"), std::string::npos) << r.output;
+    r = test::run_candela(base + "--integrator ptracer");  // integrator/caps.h: a usage error
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--target-error: not available with the ptracer integrator"), std::string::npos) << r.output;
+    r = test::run_candela(base + "--integrator bdpt");  // integrator/caps.h: a usage error
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--target-error: not available with the bdpt integrator"), std::string::npos) << r.output;
     r = test::run_candela(base + "--checkpoint " + d + "/c.ckpt");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("do not checkpoint"), std::string::npos) << r.output;

@@ -173,8 +173,8 @@ TEST(BadInput, CommandLineValues) {
     expect_clean_error(run_candela("-D novalue --out " + d + "/x.exr"), {"-D expects name=value"});
     expect_clean_error(run_candela("--frames 1073741824 --spp-per-frame 1048576 --out " + d + "/x.exr"),
                        {"more than 2^32 - 1"});
-    expect_clean_error(run_candela("--max-depth -7 --out " + d + "/x.exr"), {"--max-depth must be -1"});
     // Usage errors (a value of the wrong type or out of range) exit 2, as CLI11 parse errors do.
+    expect_clean_error(run_candela("--max-depth -7 --out " + d + "/x.exr"), {"--max-depth: max_depth must be -1"}, 2);
     expect_clean_error(run_candela("--width abc --out " + d + "/x.exr"), {"--width"}, 2);
     expect_clean_error(run_candela("--frames 0 --out " + d + "/x.exr"), {"--frames"}, 2);
     // An output that cannot be written is refused before rendering, not after.

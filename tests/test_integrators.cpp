@@ -203,10 +203,10 @@ TEST(DifferentiableIntegrators, PrimalImagesMatchMitsuba) {
 }
 
 TEST(PathHideEmitters, CameraRaysPassThroughEmitters) {
-    // Emitters only (max depth 0): the light is the only non-black thing; hidden, nothing is left.
+    // Emitters only (Mitsuba's max depth 1): the light is the only non-black thing; hidden, nothing is left.
     SceneOverrides ov;
     ov.width = ov.height = 24;
-    ov.max_depth = 0;
+    ov.max_depth = 1;
     auto shown = prepare_scene("", ov);
     SceneParams p = shown->params();
     p.settings.integrator.hide_emitters = true;

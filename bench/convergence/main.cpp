@@ -8,10 +8,12 @@
 // 1 / (relMSE x time), and the time to reach a common target error).
 //
 // A configuration is "label:key=value,key=value" with keys sampling (light|bsdf|mis), integrator
-// (path|bdpt|ptracer|direct), max_depth, rr_depth, accel (auto|kdtree|hybrid|brute), threads, seed. Biased settings (finite max_depth)
+// (path|bdpt|ptracer|direct), max_depth, rr_depth (Mitsuba's, as --max-depth and --rr-depth), accel
+// (auto|kdtree|hybrid|brute), threads, seed. Biased settings (finite max_depth)
 // converge to the wrong image: their error flattens at the bias, and the table marks them.
 //
-// --depth-bias D1..D2 instead measures the energy lost by truncation: for each max depth it renders
+// --depth-bias D1..D2 instead measures the energy lost by truncation: for each max depth (Mitsuba's,
+// >= 1) it renders
 // the same samples (same seed, so every truncated path is a prefix of the unbounded one) and
 // reports the whole-image mean against the unbounded render.
 #include <CLI/CLI.hpp>
@@ -215,7 +217,7 @@ int main(int argc, char** argv) try {
     app.add_option("--out", out, "Output prefix: PREFIX.csv, PREFIX.svg, PREFIX.md");
     app.add_option("--title", title, "Plot title");
     app.add_option("--target", target_arg, "relMSE for the time-to-error column (default: the median final relMSE of the unbiased configurations)");
-    app.add_option("--depth-bias", depth_bias, "D1 D2: energy lost at max depth D1..D2 against unbounded")->expected(2);
+    app.add_option("--depth-bias", depth_bias, "D1 D2: energy lost at max depth D1..D2 (Mitsuba's) against unbounded")->expected(2);
     app.add_option("--bias-spp", bias_spp, "Samples per pixel per batch for --depth-bias");
     app.add_option("--bias-batches", bias_batches, "Batches for --depth-bias (standard errors)");
     app.add_option("--threads", threads, "Threads for --depth-bias");

@@ -217,6 +217,8 @@ int run_headless(const HeadlessOptions& opt) {
     const uint64_t target = frames * uint64_t(spp_per_pass);
     if (target > std::numeric_limits<uint32_t>::max())
         throw Error("--frames x --spp-per-frame is " + std::to_string(target) + " samples per pixel, more than 2^32 - 1");
+    check_run_features(st, {false, opt.target_error > 0, !opt.checkpoint.empty() || !opt.resume.empty(),
+                            opt.time_limit > 0});
     const std::vector<AovSpec>& aovs = st.integrator.aovs;
     if (!aovs.empty() && !opt.checkpoint.empty())
         throw Error(opt.checkpoint, 0, "checkpoints do not hold the aov integrator's layers; render it without --checkpoint");
@@ -233,9 +235,6 @@ int run_headless(const HeadlessOptions& opt) {
         if (st.sampler.type != SamplerType::Independent)
             throw Error(src, 0, std::string("--target-error needs the independent sampler (the halves must be "
                                             "independent), not ") + sampler_type_name(st.sampler.type));
-        if (st.integrator.type == IntegratorType::Ptracer || st.integrator.type == IntegratorType::Bdpt ||
-            st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt)
-            throw Error(src, 0, "--target-error needs camera paths per pixel; the splats of ptracer and bdpt land anywhere");
         if (film.weighted()) throw Error(src, 0, "--target-error needs the box reconstruction filter");
         if (!aovs.empty()) throw Error(src, 0, "--target-error does not render the aov integrator's layers");
         if (st.alpha) throw Error(src, 0, "--target-error does not render an alpha channel (rgba film)");
@@ -354,11 +353,11 @@ int run_headless(const HeadlessOptions& opt) {
         // Memory first: scripts read the summary from the last line.
         print_memory_summary(scene);
         std::fprintf(stderr,
-                     "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
+                     "candela: %s%s %dx%d, %s, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",
                      sig ? (sig == SIGTERM ? "terminated: " : "interrupted: ") : stopped_by_limit ? "time limit: " : "",
                      scene.source.c_str(), film.width(),
-                     film.height(), spp, secs, secs > 0 ? samples / secs * 1e-6 : 0.0,
+                     film.height(), integrator_summary(st).c_str(), spp, secs, secs > 0 ? samples / secs * 1e-6 : 0.0,
                      secs > 0 ? rays / secs * 1e-6 : 0.0, threads, scene.accel->name().c_str(),
                      (unsigned long long)film.nonfinite_count(), written.c_str());
         if (adaptive) {

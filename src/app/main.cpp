@@ -34,9 +34,12 @@ int main(int argc, char** argv) {
     app.add_option("--out", opt.out, "Write the image and exit: .png (sRGB through the display shaders), .exr or .pfm (linear)");
     auto* w_opt = app.add_option("--width", width, "Image width in pixels (overrides the scene)");
     auto* h_opt = app.add_option("--height", height, "Image height in pixels (overrides the scene)");
-    auto* d_opt = app.add_option("--max-depth", max_depth, "Scattering events per path: 0 emitters only, 1 direct light, -1 unbounded (default).\n"
-                                                       "A finite depth is biased: it drops longer paths");
-    auto* r_opt = app.add_option("--rr-depth", rr_depth, "Scattering events before Russian roulette starts");
+    auto* d_opt = app.add_option("--max-depth", max_depth,
+                                 "Mitsuba's max_depth, path segments: 1 emitters only, 2 direct light, -1 unbounded\n"
+                                 "(default; overrides the scene). A finite depth is biased: it drops longer paths");
+    auto* r_opt = app.add_option("--rr-depth", rr_depth,
+                                 "Mitsuba's rr_depth (>= 1, default 5): the path vertex from which Russian roulette\n"
+                                 "may end a path (overrides the scene)");
     auto* s_opt = app.add_option("--seed", seed, "Sampler seed (overrides the scene)");
     app.add_option("--threads", opt.threads, "Render threads (default: all cores)")->check(CLI::Range(0, 1024));
     app.add_option("--time-limit", opt.time_limit, "Stop after this many seconds (the image has the passes done by then)")
@@ -61,11 +64,12 @@ int main(int argc, char** argv) {
                                  "the sample count is mutations per pixel, docs/mlt.md);\n"
                                  "replaces the scene's <integrator> type, keeping its depths and hide_emitters")
                       ->check(CLI::IsMember({"path", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
-    auto* m_opt = app.add_option("--sampling", sampling, "Light transport sampling: light, bsdf or mis (default mis)");
+    auto* m_opt = app.add_option("--sampling", sampling,
+                                 "The path tracer's emission sampling (path, pssmlt): light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
                                        "Sampler (overrides the scene): independent, stratified, multijitter, ldsampler,\n"
                                        "sobol (Owen-scrambled per pixel), zsobol (Z-order blue noise) or orthogonal\n"
-                                       "(orthogonal arrays, p^2 spp); docs/samplers.md");
+                                       "(orthogonal arrays, p^2 spp); docs/samplers.md. Not for pssmlt and mmlt");
     auto* count_opt = app.add_option("--sample-count", sample_count,
                                      "The scene's sample_count (overrides it): the default total spp, and what the\n"
                                      "stratified samplers stratify over (rounded up as the sampler needs)")
@@ -164,6 +168,9 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "candela: %s; rendering headless to %s\n", why_headless.c_str(), opt.out.c_str());
         }
         return run_headless(opt);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "candela: %s (see --help)\n", e.what());
+        return 2;
     } catch (const Error& e) {
         std::fprintf(stderr, "candela: %s\n", e.what());
         return 1;

@@ -282,6 +282,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
             throw Error("--target-error is not available under MPI (docs/adaptive.md): render without it, or in one process");
         scene_ptr = prepare_scene(opt.scene, opt.overrides);
         const RenderSettings& st = scene_ptr->settings;
+        check_run_features(st, {true, false, !opt.checkpoint.empty() || !opt.resume.empty(), opt.time_limit > 0});
         chunk = uint32_t(std::max(1, opt.spp_per_frame));
         const uint64_t frames = opt.frames > 0 ? uint64_t(opt.frames) : uint64_t(std::max(1, st.spp / int(chunk)));
         const uint64_t t = frames * uint64_t(chunk);
@@ -593,10 +594,10 @@ int run_headless_mpi(const HeadlessOptions& opt) {
                      size, threads, chunk, per_rank.c_str(), double(bytes_received) / 1e6, (unsigned long long)messages,
                      recv_seconds, red.add_seconds);
         std::fprintf(stderr,
-                     "candela: %s%s %dx%d, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d ranks x %d threads, "
+                     "candela: %s%s %dx%d, %s, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d ranks x %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",
                      stop_signal ? (stop_signal == SIGTERM ? "terminated: " : "interrupted: ") : time_up ? "time limit: " : "",
-                     scene.source.c_str(), st.width, st.height, spp, secs, secs > 0 ? double(red.samples) / secs * 1e-6 : 0.0,
+                     scene.source.c_str(), st.width, st.height, integrator_summary(st).c_str(), spp, secs, secs > 0 ? double(red.samples) / secs * 1e-6 : 0.0,
                      secs > 0 ? double(red.rays) / secs * 1e-6 : 0.0, size, threads, scene.accel->name().c_str(),
                      (unsigned long long)film->nonfinite_count(), wi.path.c_str());
         if (checkpointing && prefix > 0)

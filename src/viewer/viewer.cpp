@@ -48,6 +48,7 @@ Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
 void Viewer::init() {
     const ViewerOptions& opt = opt_;
     std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
+    for (const std::string& w : scene->warnings) std::fprintf(stderr, "candela: warning: %s\n", w.c_str());
     open_window(scene->settings.width, scene->settings.height);
 
     SessionOptions so;

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <thread>
+#include "integrator/caps.h"
 #include "integrator/mlt/pssmlt.h"
 #include "viewer/panel.h"
 #include "viewer/window.h"
@@ -103,20 +105,23 @@ void Viewer::panel() {
     if (ImGui::CollapsingHeader("Integrator", ImGuiTreeNodeFlags_DefaultOpen)) {
         RenderSettings& st = fe_->params().settings;
         // Switches the running render: the next pass makes the new integrator (render_pass).
-        // The aov and moment wrappers need camera rays: ptracer is offered without them only.
+        // The aov and moment wrappers need camera rays: only the integrators that take them
+        // (integrator/caps.h) are offered with them.
         const bool wrapped = !st.integrator.aovs.empty();
-        static const IntegratorType kTypes[] = {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer,
-                                                IntegratorType::Bdpt, IntegratorType::Pssmlt, IntegratorType::Mmlt};
-        int type = st.integrator.type == IntegratorType::Direct    ? 1
-                   : st.integrator.type == IntegratorType::Ptracer ? 2
-                   : st.integrator.type == IntegratorType::Bdpt    ? 3
-                   : st.integrator.type == IntegratorType::Pssmlt  ? 4
-                   : st.integrator.type == IntegratorType::Mmlt    ? 5
-                                                                   : 0;
-        if (ImGui::Combo("integrator", &type,
-                         wrapped ? "path\0direct\0" : "path\0direct\0ptracer (light tracing)\0bdpt (bidirectional)\0pssmlt (Metropolis)\0mmlt (multiplexed Metropolis)\0")) {
-            st.integrator.type = kTypes[type];
-            fe_->params_changed(viewer_now());
+        static const char* const kLabels[] = {"path", "direct", "ptracer (light tracing)", "bdpt (bidirectional)",
+                                              "pssmlt (Metropolis)", "mmlt (multiplexed Metropolis)"};
+        static_assert(std::size(kLabels) == std::size(kIntegratorTypes));
+        if (ImGui::BeginCombo("integrator", kLabels[std::find(std::begin(kIntegratorTypes), std::end(kIntegratorTypes),
+                                                              st.integrator.type) - std::begin(kIntegratorTypes)])) {
+            for (size_t k = 0; k < std::size(kIntegratorTypes); ++k) {
+                const IntegratorType t = kIntegratorTypes[k];
+                if (wrapped && !reads(t).aovs) continue;
+                if (ImGui::Selectable(kLabels[k], t == st.integrator.type) && t != st.integrator.type) {
+                    st.integrator.type = t;
+                    fe_->params_changed(viewer_now());
+                }
+            }
+            ImGui::EndCombo();
         }
         if (ImGui::IsItemHovered())
             ImGui::SetTooltip("path: path tracing with next-event estimation and MIS\n"
@@ -138,33 +143,60 @@ void Viewer::panel() {
                                       ms.b_std_error, (unsigned long long)ms.mutations, st.integrator.mlt.chains);
             }
         }
+        // What the integrator does not read is greyed out (integrator/caps.h): it cannot change,
+        // so it cannot restart a render for nothing.
+        const IntegratorCaps& caps = reads(st.integrator.type);
+        const char* unread = "not read by this integrator";
+        ImGui::BeginDisabled(!caps.sampling);
         int mode = int(st.sampling);
         if (ImGui::Combo("sampling", &mode, "light sampling\0BSDF sampling\0MIS\0")) {
             st.sampling = SamplingMode(mode);
             fe_->params_changed(viewer_now());
         }
+        ImGui::EndDisabled();
+        if (!caps.sampling && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", unread);
+        ImGui::BeginDisabled(!caps.sampler);
         int sampler = int(st.sampler.type);
         if (ImGui::Combo("sampler", &sampler, "independent\0stratified\0multijitter\0ldsampler\0sobol\0zsobol\0orthogonal\0")) {
             st.sampler.type = SamplerType(sampler);
             fe_->params_changed(viewer_now());
         }
-        if (ImGui::IsItemHovered())
-            ImGui::SetTooltip("Where the random numbers come from (docs/samplers.md). The stratified ones stratify\n"
-                              "over the scene's sample_count (%d): complete sets every %u samples.",
-                              st.spp, sampler_sample_count(st.sampler.type, uint32_t(std::max(1, st.spp))));
-        if (ImGui::InputInt("max depth", &st.max_depth)) {
-            st.max_depth = std::max(-1, st.max_depth);
+        ImGui::EndDisabled();
+        if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+            if (!caps.sampler) ImGui::SetTooltip("%s: its Markov chains draw their own random numbers", unread);
+            else
+                ImGui::SetTooltip("Where the random numbers come from (docs/samplers.md). The stratified ones stratify\n"
+                                  "over the scene's sample_count (%d): complete sets every %u samples.",
+                                  st.spp, sampler_sample_count(st.sampler.type, uint32_t(std::max(1, st.spp))));
+        }
+        // Mitsuba's max_depth (path segments), as in scene files and --max-depth (integrator/depth.h).
+        ImGui::BeginDisabled(!caps.max_depth);
+        int max_depth = max_depth_to_mitsuba(st.max_depth);
+        if (ImGui::InputInt("max depth", &max_depth)) {
+            // -1 or >= 1 (max_depth_error): stepping down from 1 goes to -1, up from -1 to 1.
+            max_depth = max_depth == 0 ? (st.max_depth < 0 ? 1 : -1) : std::max(-1, max_depth);
+            st.max_depth = max_depth_from_mitsuba(max_depth);
             fe_->params_changed(viewer_now());
         }
-        if (ImGui::IsItemHovered())
-            ImGui::SetTooltip("Scattering events per path; -1: unbounded (unbiased, ended by Russian roulette)");
+        ImGui::EndDisabled();
+        if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+            ImGui::SetTooltip(caps.max_depth ? "Mitsuba's max_depth: path segments (1: emitters only, 2: direct light);\n"
+                                               "-1: unbounded (unbiased, ended by Russian roulette)"
+                                             : "not read by this integrator: it has no depth");
         // A finite depth drops every longer path: the image converges to a darker one. Say so
         // where the setting is made (docs/accuracy.md measures the energy lost per depth).
-        if (st.max_depth >= 0) ImGui::TextColored(ImVec4(1.f, 0.75f, 0.3f, 1.f), "biased: paths longer than %d are dropped", st.max_depth);
+        if (caps.max_depth && st.max_depth >= 0)
+            ImGui::TextColored(ImVec4(1.f, 0.75f, 0.3f, 1.f), "biased: paths longer than %d segments are dropped",
+                               max_depth_to_mitsuba(st.max_depth));
+        ImGui::BeginDisabled(!caps.rr_depth);
         if (ImGui::InputInt("RR depth", &st.rr_depth)) {
-            st.rr_depth = std::max(0, st.rr_depth);
+            st.rr_depth = std::max(1, st.rr_depth);  // rr_depth_error: >= 1
             fe_->params_changed(viewer_now());
         }
+        ImGui::EndDisabled();
+        if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+            ImGui::SetTooltip(caps.rr_depth ? "Mitsuba's rr_depth: the path vertex from which Russian roulette may end a path"
+                                            : "not read by this integrator: it has no Russian roulette");
         ImGui::Text("accelerator: %s", fe_->scene().accel ? fe_->scene().accel->name().c_str() : "-");
     }
 

@@ -1,22 +1,21 @@
 #include "scene/plugins/render_factories.h"
 #include <cmath>
 #include <sstream>
+#include "integrator/depth.h"
 
 namespace candela {
 
 namespace {
 
-// path, volpath: Mitsuba's MonteCarloIntegrator parameters. Mitsuba's max_depth counts path
-// segments, candela's scattering events.
+// path, volpath: Mitsuba's MonteCarloIntegrator parameters, checked and converted by the same
+// rules as --max-depth and --rr-depth (integrator/desc.h).
 // `default_depth` is Mitsuba's: -1 for the C++ integrators, 6 for the Python (differentiable) ones.
 void read_depths(const ParamSet& p, RenderSettings& st, int default_depth = -1) {
-    int max_depth = p.get_int("max_depth", default_depth);
-    int rr_depth = p.get_int("rr_depth", 5);
-    if (max_depth < -1) throw p.error("max_depth", "max_depth must be -1 (unbounded) or positive");
-    // A Mitsuba depth of 0 renders black; that is never what a user wants, so it is rejected.
-    if (max_depth == 0) throw p.error("max_depth", "max_depth 0 renders a black image; use -1 or a value >= 1");
-    if (rr_depth <= 0) throw p.error("rr_depth", "rr_depth must be greater than zero");
-    st.max_depth = max_depth < 0 ? -1 : max_depth - 1;
+    const int max_depth = p.get_int("max_depth", default_depth);
+    const int rr_depth = p.get_int("rr_depth", 5);
+    if (const char* e = max_depth_error(max_depth)) throw p.error("max_depth", e);
+    if (const char* e = rr_depth_error(rr_depth)) throw p.error("rr_depth", e);
+    st.max_depth = max_depth_from_mitsuba(max_depth);
     st.rr_depth = rr_depth;
 }
 
@@ -99,7 +98,7 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
         read_depths(p, st, 6);
         if (type == "prb_projective" || type == "direct_projective") read_projective(p);
         if (type == "prb_basic") st.sampling = SamplingMode::Bsdf;
-        if (type == "direct_projective") st.max_depth = 1;
+        if (type == "direct_projective") st.max_depth = max_depth_from_mitsuba(2);
         d.type = IntegratorType::Path;
         d.hide_emitters = p.get_bool("hide_emitters", false);
         p.report_unused();
@@ -116,8 +115,9 @@ IntegratorRole read_integrator(const std::string& type, const ParamSet& p, Rende
             throw p.error(p.has("bsdf_samples") ? "bsdf_samples" : "shading_samples",
                           "direct needs at least one BSDF or emitter sample");
         d.hide_emitters = p.get_bool("hide_emitters", false);
-        // The direct integrator has no depth: it is one scattering event.
-        st.max_depth = 1;
+        // The direct integrator has no depth: it is one scattering event (Mitsuba's max_depth 2),
+        // which --integrator path keeps.
+        st.max_depth = max_depth_from_mitsuba(2);
         p.report_unused();
         return IntegratorRole::Renders;
     }

@@ -1,4 +1,5 @@
 // The integrator family of the XML reader: Mitsuba 3's integrators as RenderSettings.
+#include "integrator/caps.h"
 #include "scene/plugins/render_factories.h"
 #include "scene/xml/plugins.h"
 
@@ -13,14 +14,10 @@ void load_integrator(XmlLoader& L, pugi::xml_node n) {
     for (int level = 0;; ++level) {
         Object o = L.read_object(n, "integrator");
         if (read_integrator(o.type, o.params, s, o.line) == IntegratorRole::Renders) {
-            // The light tracer's image is all splats: there is no camera ray to take AOVs or moments of.
-            if (s.integrator.type == IntegratorType::Ptracer && (level > 0 || !moment.empty()))
-                throw L.error(n, "ptracer cannot be nested in an aov or moment integrator (it traces no camera rays)");
-            if (s.integrator.type == IntegratorType::Bdpt && (level > 0 || !moment.empty()))
-                throw L.error(n, "bdpt cannot be nested in an aov or moment integrator (not supported)");
-            if ((s.integrator.type == IntegratorType::Pssmlt || s.integrator.type == IntegratorType::Mmlt) &&
-                (level > 0 || !moment.empty()))
-                throw L.error(n, "pssmlt and mmlt cannot be nested in an aov or moment integrator (their image is all splats)");
+            // The aov and moment wrappers take values of camera rays (integrator/caps.h).
+            if (!reads(s.integrator.type).aovs && (level > 0 || !moment.empty()))
+                throw L.error(n, o.type + " cannot be nested in an aov or moment integrator (it traces no camera ray "
+                                          "per pixel sample)");
             L.finish(o);
             break;
         }
