@@ -518,6 +518,61 @@ TEST(Mlt, MmltBrightnessSpreadMatchesItsError) {
     EXPECT_GE(z.p_value, kAlpha);
 }
 
+namespace {
+double mlt_mean(const Film& f, const MltStats& st) {
+    Film shown;
+    mlt_output(f, st, shown);
+    return image_mean(shown);
+}
+}  // namespace
+
+// The brightness converges as the chains run (issue 41: before, the image's mean was the
+// bootstrap's b whatever the mutations). Cornell box 16 x 16, hidden lamp, max depth 3, a small
+// bootstrap (500 paths per depth, 2000 in all) and 64 mutations per pixel (4900 large steps): b's
+// reported error must fall by more than 1.4 from the first index to the last (sqrt(6900 / 2000) =
+// 1.86 if the per-path spread stayed), and the image's mean (the latest b, mlt_output) over 12
+// seeds must spread as that error says (chi-square on K - 1 dof; control: a third of the error
+// rejected) about the path tracer's mean.
+TEST(Mlt, MmltBrightnessConvergesWithTheMutations) {
+    constexpr int K = 12, res = 16;
+    auto scene = cornell(res, 3);
+    MltParams m;
+    m.bootstrap_samples = 500;
+    m.chains = 64;
+    RunningStats means;
+    double se2_boot = 0, se2 = 0;
+    for (int k = 0; k < K; ++k) {
+        Film f(res, res);
+        auto sc = with(*scene, IntegratorType::Mmlt, uint64_t(k) + 1, &m);
+        Renderer::render_pass(*sc, f, 0, 1, 2);
+        se2_boot += sqr(pssmlt_stats().b_std_error) / K;
+        Renderer::render_pass(*sc, f, 1, 63, 2);
+        const MltStats st = pssmlt_stats();
+        means.add(mlt_mean(f, st));
+        se2 += sqr(st.b_std_error) / K;
+    }
+    RunningStats pt;
+    for (int k = 0; k < K; ++k) {
+        Film f(res, res);
+        Renderer::render_pass(*with(*scene, IntegratorType::Path, uint64_t(k) + 101), f, 0, 64, 2);
+        pt.add(image_mean(f));
+    }
+    const double chi2 = means.variance() * (K - 1) / se2, chi2_ctl = chi2 * 9;
+    const double p = chi_square_sf(chi2, K - 1), p_ctl = chi_square_sf(chi2_ctl, K - 1);
+    const MeanTest z = z_test(means.mean(), std::sqrt(se2 / K + sqr(pt.std_error())), pt.mean());
+    const double shrink = std::sqrt(se2_boot / se2);
+    std::printf("  b's reported error after 1 and 64 mutations per pixel: %.5f, %.5f (ratio %.2f)\n"
+                "  image mean over %d seeds %.5f, sd %.5f (%.1f%%); reported se %.5f (%.1f%%): chi2 %.2f (%d dof) p = %.3g, "
+                "errors / 3: p = %.3g\n  path tracer %.5f +- %.5f: %s\n",
+                std::sqrt(se2_boot), std::sqrt(se2), shrink, K, means.mean(), std::sqrt(means.variance()),
+                100 * std::sqrt(means.variance()) / means.mean(), std::sqrt(se2), 100 * std::sqrt(se2) / means.mean(), chi2,
+                K - 1, p, p_ctl, pt.mean(), pt.std_error(), z.describe().c_str());
+    EXPECT_GT(shrink, 1.4) << "b's error does not shrink as the chains run";
+    EXPECT_GE(p, 0.01) << "the image's brightness varies more over seeds than its reported error";
+    EXPECT_LT(p_ctl, 0.01) << "a third of the reported error is not rejected";
+    EXPECT_GE(z.p_value, 0.01);
+}
+
 TEST(Mlt, MmltDepthNote) {
     EXPECT_EQ(mmlt_depths(5), 6);
     EXPECT_EQ(mmlt_depths(30), 31);  // an explicit depth is honoured (issue 41: it was capped at 12)

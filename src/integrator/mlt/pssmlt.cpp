@@ -517,7 +517,11 @@ PassStats mlt_pass(const Evaluator& ev, const Scene& scene, Film& film, uint32_t
     PassStats out = splat_pass_units(film, first_sample, spp, threads, cancel, n_chains, work, merge);
     out.rays += rays + replay_rays.load();
     if (!out.completed) {
-        g_chains.reset();  // a sample index was cut part-way: the chains are between indices
+        // The film holds the indices completed before the cut (each adds N mutations): the stats
+        // describe them, then the chains, left part-way through an index, are dropped.
+        set.next_index = first_sample + uint32_t(out.samples / pixels);
+        publish(set, pixels);
+        g_chains.reset();
         return out;
     }
     set.next_index = first_sample + uint32_t(spp);
