@@ -22,6 +22,7 @@
 #include "core/interrupt.h"
 #include "core/progress.h"
 #include "film/image_io.h"
+#include "render/launch.h"
 #include "render/renderer.h"
 
 namespace candela {

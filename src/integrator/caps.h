@@ -44,11 +44,11 @@ inline constexpr IntegratorCaps kPtracerCaps {false,  true,   false, true,  true
 // bdpt: every (s, t) strategy weighted by MIS, whatever the sampling mode.
 inline constexpr IntegratorCaps kBdptCaps    {false,  true,   true,  true,  true,  true,  true,  false, false, true,  true,  false, false};
 // pssmlt: the path tracer (with its sampling mode) on the chains' own primary samples, box splats.
-// MPI: every rank replays all the chains' mutations (R ranks, R times the work) and the image is the
-// one-process image; splitting the chains over the ranks is another change (issue 41).
-inline constexpr IntegratorCaps kPssmltCaps  {true,   false,  false, true,  true,  true,  true,  false, false, true,  true,  false, false};
-// mmlt: BDPT's strategies on the chains' own primary samples, box splats; MPI as pssmlt.
-inline constexpr IntegratorCaps kMmltCaps    {false,  false,  false, true,  true,  true,  true,  false, false, true,  true,  false, false};
+// No MPI: the chains carry state from one sample index to the next and the film is scaled by a b
+// refined as they run, so sample indices cannot go to ranks independently (docs/distributed.md).
+inline constexpr IntegratorCaps kPssmltCaps  {true,   false,  false, true,  true,  true,  false, false, false, true,  true,  false, false};
+// mmlt: BDPT's strategies on the chains' own primary samples, box splats; no MPI, as pssmlt.
+inline constexpr IntegratorCaps kMmltCaps    {false,  false,  false, true,  true,  true,  false, false, false, true,  true,  false, false};
 // clang-format on
 
 constexpr const IntegratorCaps& reads(IntegratorType t) {

@@ -91,7 +91,7 @@ void check_run_features(const RenderSettings& st, const RunFeatures& f) {
             throw UsageError(std::string(option) + ": not available with the " + integrator_type_name(st.integrator.type) +
                              " integrator (" + why + ")");
     };
-    require(f.mpi, c.mpi, "mpirun", "it does not split across ranks");
+    require(f.mpi, c.mpi, "mpirun", "its sample indices do not split across ranks: render it in one process");
     require(f.adaptive, c.adaptive, "--target-error", "it needs camera samples per pixel; splats land anywhere");
     require(f.checkpoint, c.checkpoint, "--checkpoint", "its state is not saved");
     require(f.time_limit, c.time_limit, "--time-limit", "its passes cannot be cut");
