@@ -1,4 +1,5 @@
 #include "scene/sensors.h"
+#include <cctype>
 #include <cmath>
 
 namespace candela {
@@ -124,16 +125,35 @@ FilmDesc make_hdrfilm(const ParamSet& p) {
         throw p.error(p.has("crop_height") ? "crop_height" : "crop_offset_y",
                       "the crop window (y " + std::to_string(f.crop_offset.y) + " + height " + std::to_string(f.crop_size.y) +
                           ") does not fit in the film's height " + std::to_string(f.height));
-    std::string pf = p.get_string("pixel_format", "rgb");
+    // Mitsuba 3.9's hdrfilm (src/films/hdrfilm.cpp): the three formats are lower-cased, checked
+    // against its lists, and shape only the file it writes; candela's output is chosen by --out.
+    auto note = [&](const std::string& name, const std::string& what) {
+        f.notes.push_back(p.file() + ":" + std::to_string(p.line_of(name)) + ": hdrfilm: " + what);
+    };
+    auto lower = [](std::string v) {
+        for (char& c : v) c = char(std::tolower((unsigned char)c));
+        return v;
+    };
+    const std::string pf = lower(p.get_string("pixel_format", "rgb"));
+    if (pf != "rgb" && pf != "rgba" && pf != "luminance" && pf != "luminance_alpha" && pf != "xyz" && pf != "xyza")
+        throw p.error("pixel_format", "unknown pixel_format '" + pf + "' (rgb, rgba, luminance, luminance_alpha, xyz or xyza)");
+    f.alpha = pf == "rgba" || pf == "luminance_alpha" || pf == "xyza";
     if (pf != "rgb" && pf != "rgba")
-        throw p.error("pixel_format", "unsupported pixel_format '" + pf + "' (rgb or rgba: candela renders RGB only)");
-    f.alpha = pf == "rgba";
-    // candela writes 32-bit float EXR whichever Mitsuba would write: both are accepted.
-    std::string cf = p.get_string("component_format", "float16");
-    if (cf != "float16" && cf != "float32")
-        throw p.error("component_format", "unsupported component_format '" + cf + "' (float16 or float32)");
-    std::string ff = p.get_string("file_format", "openexr");
-    if (ff != "openexr") throw p.error("file_format", "unsupported file_format '" + ff + "' (openexr)");
+        note("pixel_format", "pixel_format '" + pf + "' shapes Mitsuba's output file only: candela writes RGB" +
+                                 (f.alpha ? "A" : ""));
+    const std::string cf = lower(p.get_string("component_format", "float16"));
+    if (cf != "float16" && cf != "float32" && cf != "uint32")
+        throw p.error("component_format", "unknown component_format '" + cf + "' (float16, float32 or uint32)");
+    if (cf == "uint32") note("component_format", "component_format 'uint32' ignored: candela writes 32-bit float EXR");
+    const std::string ff = lower(p.get_string("file_format", "openexr"));
+    if (ff != "openexr" && ff != "exr" && ff != "rgbe" && ff != "pfm")
+        throw p.error("file_format", "unknown file_format '" + ff + "' (openexr, exr, rgbe or pfm)");
+    if (ff == "rgbe" || ff == "pfm") note("file_format", "file_format '" + ff + "' ignored: the output format is --out's extension");
+    // A Mitsuba 0.x parameter that Mitsuba 3 accepts and ignores (hdrfilm marks it queried).
+    if (p.has("banner")) {
+        p.get_bool("banner", false);
+        note("banner", "banner ignored (a Mitsuba 0.x parameter; Mitsuba 3 ignores it too)");
+    }
     return f;
 }
 

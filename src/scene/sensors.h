@@ -5,6 +5,7 @@
 // ProjectiveCamera, src/sensors/*.cpp, src/render/film.cpp). Every value a factory reads is marked
 // used; errors name the parameter's line.
 #include <string>
+#include <vector>
 #include "scene/camera.h"
 #include "scene/params.h"
 
@@ -24,11 +25,14 @@ void read_fov(const ParamSet& p, Camera& cam);
 // (film_size, crop) is left for apply_film.
 Camera make_sensor(const std::string& type, const ParamSet& p);
 
-// What an hdrfilm says: its size, the crop window and whether the output has alpha.
+// What an hdrfilm says: its size, the crop window and whether the output has alpha. Parameters
+// that only shape Mitsuba's own output file (banner, file_format, component_format, a pixel_format
+// other than rgb/rgba) are accepted as Mitsuba 3.9 accepts them, each with a one-line note.
 struct FilmDesc {
     int width = 768, height = 576;
     ivec2 crop_offset{0}, crop_size{768, 576};  // the whole film: nothing cropped
-    bool alpha = false;                  // pixel_format rgba
+    bool alpha = false;                  // pixel_format rgba (or luminance_alpha, xyza)
+    std::vector<std::string> notes;      // "file:line: what", for SceneDescription::warnings
 };
 FilmDesc make_hdrfilm(const ParamSet& p);
 

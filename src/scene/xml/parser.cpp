@@ -319,7 +319,9 @@ void XmlLoader::load_default(pugi::xml_node n) {
 }
 
 // <path value>: a folder searched first (before the earlier ones) for every file named later.
-// Relative to the file it is written in, else found through the search path, as Mitsuba.
+// Relative to the file it is written in, else found through the search path, as Mitsuba. A folder
+// that is not there is only a place with nothing to find: a note, and the file is read (Mitsuba
+// 3.9 also looks in its working directory, which the scene's author had and candela cannot know).
 void XmlLoader::load_path(pugi::xml_node n) {
     check_attributes(n, {"value"});
     check_text(n);
@@ -331,7 +333,10 @@ void XmlLoader::load_path(pugi::xml_node n) {
         if (!exists(dir)) dir = resolve(n, value);
     }
     std::error_code ec;
-    if (!fs::is_directory(dir, ec)) throw error(n, "<path>: folder '" + value + "' not found");
+    if (!fs::is_directory(dir, ec)) {
+        note(n, "<path>: folder '" + value + "' not found (ignored: files are searched in the other places)");
+        return;
+    }
     if (dir.back() != '/') dir += '/';
     search_path_.insert(search_path_.begin(), dir);
 }

@@ -69,6 +69,10 @@ public:
     const std::string& file_of(pugi::xml_node n) const;           // the file a node was read from
     int line(pugi::xml_node n) const;
     Error error(pugi::xml_node n, const std::string& what) const { return Error(file_of(n), line(n), what); }
+    // A non-fatal message "file:line: what" for SceneDescription::warnings (the app prints them).
+    void note(pugi::xml_node n, const std::string& what) {
+        scene_.warnings.push_back(file_of(n) + ":" + std::to_string(line(n)) + ": " + what);
+    }
     // A file named by the scene (mesh, texture, spectrum) as Mitsuba's file resolver finds it: an
     // absolute path as is; else the first that exists of the <path> folders (latest first), the
     // main scene's folder and the folder of the file that names it (`from`'s document). When none

@@ -17,6 +17,7 @@ Camera make_projective(XmlLoader&, Object& o) { return make_sensor(o.type, o.par
 // window) and alpha.
 void make_hdrfilm(XmlLoader& L, Object& o, RenderSettings& s) {
     FilmDesc f = candela::make_hdrfilm(o.params);
+    for (std::string& n : f.notes) L.scene().warnings.push_back(std::move(n));
     load_rfilters(L, o, s);
     ivec2 image = apply_film(f, L.scene().camera);
     s.width = image.x;
