@@ -5,6 +5,9 @@
 #   --with-fuzz: clang and libFuzzer for scripts/fuzz.sh; --with-mpi: Open MPI for distributed
 #   rendering (docs/distributed.md; the build turns CANDELA_MPI on when it finds it)
 set -euo pipefail
+# Open Image Denoise (docs/denoising.md) is no Debian package: setup-oidn.sh fetches it once the
+# packages are in, on every successful way out of this script.
+trap 'rc=$?; [ "$rc" -eq 0 ] && bash "$(dirname "${BASH_SOURCE[0]}")/setup-oidn.sh"; exit "$rc"' EXIT
 pkgs=(
   cmake ninja-build g++ pkg-config
   libglfw3-dev libglm-dev libimgui-dev libtinyobjloader-dev libstb-dev
