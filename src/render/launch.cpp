@@ -33,6 +33,8 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
             throw Error(std::string("--integrator ") + integrator_type_name(*ov.integrator) +
                         ": the scene's aov or moment integrator needs camera rays per pixel");
     }
+    if (ov.denoise_aux && (st.integrator.type == IntegratorType::Path || st.integrator.type == IntegratorType::Direct))
+        add_denoise_aovs(st.integrator.aovs);
     if (st.max_depth < -1) throw Error("--max-depth must be -1 (unbounded) or >= 0");
     if (st.rr_depth < 0) throw Error("--rr-depth must be >= 0");
 }

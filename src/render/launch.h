@@ -18,6 +18,10 @@ struct SceneOverrides {
     std::optional<int> sample_count;     // --sample-count: the scene's sample_count
     std::optional<IntegratorType> integrator;  // --integrator: replaces the scene's <integrator>
     std::string accel = "auto";
+    // --denoise, --aov: render the denoiser's auxiliary layers (add_denoise_aovs) when the
+    // integrator traces camera paths per pixel (path, direct); the others have none to follow, and
+    // their images are denoised from the beauty alone.
+    bool denoise_aux = false;
 };
 
 // Loads `path` (or the built-in Cornell box when empty), applies the overrides and builds the
