@@ -40,6 +40,10 @@ struct ViewerOptions {
     // for --screenshot-after runs, where nobody is waiting on the window's frames.
     std::optional<RenderPriority> render_priority;
     ViewerHooks* hooks = nullptr;  // measuring tools only; frames are then paced without vsync
+    // The denoised view (docs/denoising.md): on at start, and its quality. The scene renders the
+    // denoiser's auxiliary layers whenever the library is there, so that the toggle never restarts.
+    bool denoise = false;
+    DenoiseQuality denoise_quality = DenoiseQuality::Balanced;
 };
 
 // Thrown by run_viewer when GLFW cannot initialise (no display server, a refused connection) or
