@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
         if (*i_opt) ov.integrator = parse_integrator_type(integrator);
         if (*dq_opt) parse_denoise_quality(denoise_quality, opt.denoise_quality);
         ov.denoise_aux = opt.denoise || aov_layers;
+        ov.denoise_box_filter = opt.denoise;
 
 #ifdef CANDELA_HAS_MPI
         // Under mpirun or srun every rank renders a share of one headless render.

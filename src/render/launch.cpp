@@ -44,6 +44,12 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
 std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneOverrides& ov) {
     SceneDescription desc = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
     apply_overrides(desc.settings, ov);
+    if (ov.denoise_box_filter && !desc.settings.filter.is_box()) {
+        desc.warnings.push_back((path.empty() ? std::string("the scene") : path) + ": rendered with the box filter, not " +
+                                filter_name(desc.settings.filter.type) +
+                                ", for the denoiser (it keeps noise that a wider filter correlates between pixels)");
+        desc.settings.filter = FilterDesc{};
+    }
     return build_scene(std::move(desc), ov.accel);
 }
 

@@ -50,7 +50,7 @@ void Viewer::init() {
     // The denoiser's albedo and normal cost a ray or more per sample: rendered only when the
     // library is there to use them (the panel says why the toggle is missing otherwise).
     denoise_unavailable_ = denoiser_unavailable_reason();
-    opt.overrides.denoise_aux = denoise_unavailable_.empty();
+    opt.overrides.denoise_aux = opt.overrides.denoise_box_filter = denoise_unavailable_.empty();
     std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
     open_window(scene->settings.width, scene->settings.height);
 
