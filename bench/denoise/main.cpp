@@ -13,8 +13,10 @@
 //
 //   candela-denoise time --res W H [--repeat K]
 // times Denoiser::denoise on the built-in Cornell box at W x H (4 spp, with auxiliaries) for each
-// quality: the first call (device and filters built) and the mean of the K calls after it.
+// quality: the first call (device and filters built), the mean wall time of the K calls after it,
+// and their CPU time (all threads), which depends less on what else the machine runs.
 #include <CLI/CLI.hpp>
+#include <time.h>
 #include <chrono>
 #include <cstdio>
 #include "core/error.h"
@@ -36,6 +38,13 @@ double rel_mse(const std::vector<float>& x, const std::vector<float>& r) {
         s += d * d / (double(r[i]) * double(r[i]) + 1e-2);
     }
     return s / double(x.size());
+}
+
+// CPU seconds of the whole process (all threads): what a denoise costs whatever else the machine runs.
+double cpu_now() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
@@ -101,7 +110,7 @@ int main(int argc, char** argv) {
                 dn.denoise(denoise_inputs(film, scene->settings.integrator.aovs), out);
                 const std::vector<float> raw = film.resolve();
                 const double er = rel_mse(raw, r), ed = rel_mse(out, r);
-                std::printf("| %s | %d | %.4g | %.4g | %.1f |\n", name.c_str(), spp, er, ed, er / ed);
+                std::printf("| %s | %d | %.4g | %.4g | %.2g |\n", name.c_str(), spp, er, ed, er / ed);
                 std::fflush(stdout);
                 if (!images.empty()) {
                     DisplaySettings ds;
@@ -117,7 +126,8 @@ int main(int argc, char** argv) {
             configure_film(film, scene->settings);
             Renderer::render_pass(*scene, film, 0, 4, 0);
             const DenoiseImages in = denoise_inputs(film, scene->settings.integrator.aovs);
-            std::printf("| size | quality | first call (s) | per denoise (s, mean of %d) |\n|---|---|---:|---:|\n", repeat);
+            std::printf("| size | quality | first call (s) | per denoise (s, mean of %d) | CPU per denoise (s, all threads) |\n"
+                        "|---|---|---:|---:|---:|\n", repeat);
             for (DenoiseQuality q : {DenoiseQuality::Fast, DenoiseQuality::Balanced, DenoiseQuality::High}) {
                 Denoiser dn(q);
                 std::vector<float> out;
@@ -125,9 +135,11 @@ int main(int argc, char** argv) {
                 dn.denoise(in, out);
                 const double first = now() - t0;
                 t0 = now();
+                const double c0 = cpu_now();
                 for (int k = 0; k < repeat; ++k) dn.denoise(in, out);
-                std::printf("| %dx%d | %s | %.3f | %.3f |\n", res[0], res[1], denoise_quality_name(q), first,
-                            (now() - t0) / std::max(1, repeat));
+                const double n = double(std::max(1, repeat));
+                std::printf("| %dx%d | %s | %.3f | %.3f | %.3f |\n", res[0], res[1], denoise_quality_name(q), first,
+                            (now() - t0) / n, (cpu_now() - c0) / n);
                 std::fflush(stdout);
             }
         }
