@@ -233,3 +233,18 @@ TEST(Denoise, SessionDenoisesInBackground) {
     EXPECT_NE(raw.rgb, dn.rgb);
     EXPECT_FALSE(session.take_denoised(dn));  // nothing newer
 }
+
+// --denoise renders with the box filter (a wider one correlates the noise between pixels, which
+// OIDN keeps) and says so; --aov alone keeps the scene's filter.
+TEST(DenoiseAov, DenoiseRendersWithTheBoxFilter) {
+    const std::string scene = std::string(CANDELA_TEST_DATA) + "/scenes/cbox_filter.xml";
+    SceneOverrides ov;
+    ov.denoise_aux = true;
+    auto aov_only = prepare_scene(scene, ov);
+    EXPECT_EQ(aov_only->settings.filter.type, FilterType::Gaussian);
+    ov.denoise_box_filter = true;
+    auto denoised = prepare_scene(scene, ov);
+    EXPECT_TRUE(denoised->settings.filter.is_box());
+    ASSERT_FALSE(denoised->warnings.empty());
+    EXPECT_NE(denoised->warnings.back().find("box filter, not gaussian"), std::string::npos) << denoised->warnings.back();
+}
