@@ -145,14 +145,18 @@ WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene
         }
     }
     if (ext == ".exr") {
-        write_exr_layers(opt.out, img, layers);
+        if (layers.empty()) {
+            write_linear_image(opt.out, img);
+        } else {
+            if (!img.alpha.empty()) layers.push_back({"A", img.alpha});
+            write_exr_layers(opt.out, img, layers);
+        }
         return out;
     }
     if (opt.denoise) {
         // Beside a PNG or PFM: the same EXR a .exr output would be (alpha included).
-        Image full = img;
-        if (film.has_alpha()) full.alpha = film.resolve_alpha();
-        write_exr_layers(denoise_layers_path(opt.out), full, layers);
+        if (film.has_alpha()) layers.push_back({"A", film.resolve_alpha()});
+        write_exr_layers(denoise_layers_path(opt.out), img, layers);
     } else if (!aovs.empty() && !opt.quiet) {
         std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
                      opt.out.c_str());
