@@ -5,12 +5,15 @@
 #   --with-fuzz: clang and libFuzzer for scripts/fuzz.sh; --with-mpi: Open MPI for distributed
 #   rendering (docs/distributed.md; the build turns CANDELA_MPI on when it finds it)
 set -euo pipefail
+# Open Image Denoise (docs/denoising.md) is no Debian package: setup-oidn.sh takes it from the
+# pyoidn wheel (with pip, python3-pip below) once the packages are in.
+oidn() { bash "$(dirname "${BASH_SOURCE[0]}")/setup-oidn.sh"; }
 pkgs=(
   cmake ninja-build g++ pkg-config
   libglfw3-dev libglm-dev libimgui-dev libtinyobjloader-dev libstb-dev
   libosmesa6-dev libgl-dev libpugixml-dev libcli11-dev libtinyexr-dev
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev libjpeg62-turbo-dev libhwy-dev
-  xvfb xauth
+  xvfb xauth python3-pip
 )
 for a in "$@"; do
   case "$a" in
@@ -25,6 +28,7 @@ for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ "${#missing[@]}" -eq 0 ]; then
+  oidn
   exit 0
 fi
 echo "setup.sh: installing ${missing[*]}" >&2
@@ -70,3 +74,4 @@ apt_get() {
 }
 apt_get update -qq
 apt_get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+oidn

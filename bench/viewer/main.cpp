@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
     std::string priority = "idle";
     app.add_option("--render-priority", priority, "Render threads: normal, low (nice 19) or idle (SCHED_IDLE)")
         ->check(CLI::IsMember({"normal", "low", "idle"}));
+    app.add_flag("--denoise", vo.denoise, "The denoised view on (docs/denoising.md; quality balanced)");
     CLI11_PARSE(app, argc, argv);
     vo.overrides.width = size;
     vo.overrides.height = size;
@@ -116,8 +117,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     int threads = vo.threads > 0 ? vo.threads : int(std::thread::hardware_concurrency());
-    std::printf("viewer %dx%d, %d render threads (priority %s), %.0f s, %d frames, %zu camera changes measured\n",
-                size, size, threads, priority.c_str(), b.duration, b.frames, b.update_ms.size());
+    std::printf("viewer %dx%d, %d render threads (priority %s)%s, %.0f s, %d frames, %zu camera changes measured\n",
+                size, size, threads, priority.c_str(), vo.denoise ? ", denoised view" : "", b.duration, b.frames,
+                b.update_ms.size());
     std::printf("frame  ms: median %.2f  p90 %.2f  p99 %.2f  max %.2f\n", percentile(b.frame_ms, 0.5),
                 percentile(b.frame_ms, 0.9), percentile(b.frame_ms, 0.99), percentile(b.frame_ms, 1.0));
     std::printf("frame  CPU ms (window thread): median %.2f  p90 %.2f  p99 %.2f\n", percentile(b.frame_cpu_ms, 0.5),

@@ -99,29 +99,70 @@ void check_writable(const std::string& path) {
     if (::access(dir.c_str(), W_OK) != 0) throw Error(path, 0, "cannot write in directory '" + dir + "'");
 }
 
+std::string denoise_layers_path(const std::string& out) {
+    return std::filesystem::path(out).replace_extension(".layers.exr").string();
+}
+
 WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene, const Film& film) {
     const std::string ext = file_extension(opt.out);
     const std::vector<AovSpec>& aovs = scene.settings.integrator.aovs;
     WrittenImage out{opt.out, false};
     Image img{film.width(), film.height(), film.resolve(), {}};
     if (film.has_alpha() && ext == ".exr") img.alpha = film.resolve_alpha();  // PNG and PFM: RGB only
-    if (opt.target_error > 0 && ext == ".exr") {
+    // The channels beyond R, G, B that an EXR of this render holds.
+    std::vector<ExrLayer> layers;
+    const size_t n = size_t(film.width()) * size_t(film.height());
+    if (opt.target_error > 0) {
         // Adaptive sampling: the samples each pixel took (both halves), as the channel `spp`.
-        std::vector<float> spp_plane(size_t(film.width()) * size_t(film.height()));
+        std::vector<float> spp_plane(n);
         for (int y = 0; y < film.height(); ++y)
             for (int x = 0; x < film.width(); ++x)
                 spp_plane[size_t(y) * size_t(film.width()) + size_t(x)] = float(film.samples_taken(x, y));
-        write_exr_layers(opt.out, img, {{"spp", std::move(spp_plane)}});
-    } else if (!aovs.empty() && ext == ".exr") {
+        layers.push_back({"spp", std::move(spp_plane)});
+    } else if (!aovs.empty()) {
         std::vector<std::string> names = aov_channel_names(aovs);
         std::vector<std::vector<float>> planes = film.resolve_aovs();
-        std::vector<ExrLayer> layers;
         for (size_t k = 0; k < names.size(); ++k) layers.push_back({names[k], std::move(planes[k])});
-        write_exr_layers(opt.out, img, layers);
-    } else if (ext == ".png") {
-        if (!aovs.empty() && !opt.quiet)
-            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
-                         opt.out.c_str());
+    }
+    if (opt.denoise) {
+        // The raw beauty becomes the layer "noisy"; R, G, B the denoised image. On failure the
+        // raw image stays in R, G, B and nothing is lost.
+        try {
+            const auto t0 = std::chrono::steady_clock::now();
+            Denoiser dn(opt.denoise_quality);
+            std::vector<float> denoised;
+            dn.denoise(denoise_inputs(film, aovs), denoised);
+            out.denoise_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const char* rgb[3] = {"noisy.R", "noisy.G", "noisy.B"};
+            for (int c = 0; c < 3; ++c) {
+                ExrLayer l{rgb[c], std::vector<float>(n)};
+                for (size_t i = 0; i < n; ++i) l.plane[i] = img.rgb[3 * i + size_t(c)];
+                layers.push_back(std::move(l));
+            }
+            img.rgb = std::move(denoised);
+        } catch (const DenoiseError& e) {
+            out.denoise_failed = true;
+            std::fprintf(stderr, "candela: %s; the raw image is written instead\n", e.what());
+        }
+    }
+    if (ext == ".exr") {
+        if (layers.empty()) {
+            write_linear_image(opt.out, img);
+        } else {
+            if (!img.alpha.empty()) layers.push_back({"A", img.alpha});
+            write_exr_layers(opt.out, img, layers);
+        }
+        return out;
+    }
+    if (opt.denoise) {
+        // Beside a PNG or PFM: the same EXR a .exr output would be (alpha included).
+        if (film.has_alpha()) layers.push_back({"A", film.resolve_alpha()});
+        write_exr_layers(denoise_layers_path(opt.out), img, layers);
+    } else if (!aovs.empty() && !opt.quiet) {
+        std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
+                     opt.out.c_str());
+    }
+    if (ext == ".png") {
         // The PNG goes through GL; if that fails the samples must not go with it.
         try {
             write_png_headless(opt.out, img, opt.display);
@@ -135,12 +176,20 @@ WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene
                          opt.out.c_str(), out.path.c_str());
         }
     } else {
-        if (!aovs.empty() && !opt.quiet)
-            std::fprintf(stderr, "candela: warning: the AOV layers are written to .exr output only; %s gets the image\n",
-                         opt.out.c_str());
         write_linear_image(opt.out, img);
     }
     return out;
+}
+
+void print_denoise_summary(const HeadlessOptions& opt, const Scene& scene, const WrittenImage& wi) {
+    if (!opt.denoise || wi.denoise_failed) return;
+    bool aux = false;
+    for (const AovSpec& a : scene.settings.integrator.aovs) aux = aux || a.type == AovType::DenoiseAlbedo;
+    const std::string layers = file_extension(opt.out) == ".exr" ? opt.out : denoise_layers_path(opt.out);
+    std::fprintf(stderr, "candela: denoised (Open Image Denoise, %s quality, %s) in %.3f s; raw image%s in %s\n",
+                 denoise_quality_name(opt.denoise_quality),
+                 aux ? "albedo and normal prefiltered" : "beauty only: this integrator has no camera paths to follow",
+                 wi.denoise_seconds, aux ? " and auxiliaries" : "", layers.c_str());
 }
 
 void print_memory_summary(const Scene& scene) {
@@ -357,6 +406,7 @@ int run_headless(const HeadlessOptions& opt) {
     const bool png_failed = wi.png_failed;
 
     const int sig = g_signal.load();
+    if (!opt.quiet) print_denoise_summary(opt, scene, wi);
     if (!opt.quiet) {
         double spp = double(film.total_samples()) / (double(film.width()) * film.height());
         // Memory first: scripts read the summary from the last line.
@@ -411,6 +461,7 @@ int run_headless(const HeadlessOptions& opt) {
                          opt.checkpoint.c_str());
     }
     if (png_failed) return 1;  // the file asked for is missing: a failure, even with the EXR beside it
+    if (wi.denoise_failed) return 1;  // the raw image is there, not the denoised one asked for
     return sig ? 128 + sig : 0;
 }
 

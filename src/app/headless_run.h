@@ -1,5 +1,6 @@
 #pragma once
 #include <string>
+#include "denoise/denoiser.h"
 #include "display/display.h"
 #include "film/film.h"
 #include "render/launch.h"
@@ -29,7 +30,16 @@ struct HeadlessOptions {
     // --bdpt-strategies DIR: after the render, one EXR per BDPT strategy (s, t), weighted and
     // unweighted, over the same samples per pixel (integrator/bdpt/bdpt.h render_bdpt_strategies).
     std::string bdpt_strategies;
+    // --denoise (docs/denoising.md): the image at `out` is denoised by Open Image Denoise; the raw
+    // beauty ("noisy.R" ...) and the auxiliaries ("albedo.R" ..., "normal.X" ...) are layers of the
+    // EXR: `out` itself when it is .exr, else denoise_layers_path(out) beside it. When denoising
+    // fails the raw image is written instead, and the exit status is 1.
+    bool denoise = false;
+    DenoiseQuality denoise_quality = DenoiseQuality::High;
 };
+
+// The EXR beside a --denoise output that is not .exr: "out.png" -> "out.layers.exr".
+std::string denoise_layers_path(const std::string& out);
 
 // Renders the passes, shows progress (a bar on a terminal, a summary line otherwise), and writes
 // the image. SIGINT/SIGTERM stop the render early: the image so far is still written and the
@@ -46,8 +56,12 @@ void check_writable(const std::string& path);
 struct WrittenImage {
     std::string path;
     bool png_failed = false;
+    bool denoise_failed = false;  // --denoise asked for and not done: the raw image was written
+    double denoise_seconds = 0;
 };
 WrittenImage write_headless_image(const HeadlessOptions& opt, const Scene& scene, const Film& film);
+// The line saying what --denoise did (nothing when it was not asked for or failed).
+void print_denoise_summary(const HeadlessOptions& opt, const Scene& scene, const WrittenImage& wi);
 // The summary line of the scene's memory (triangles, MB, bytes per triangle).
 void print_memory_summary(const Scene& scene);
 

@@ -91,6 +91,20 @@ int main(int argc, char** argv) {
                                       "Headless: continue the render saved in checkpoint FILE (same scene and options; "
                                       "--frames is the total)")
                            ->type_name("FILE");
+    app.add_flag("--denoise", opt.denoise,
+                 "Denoise with Intel Open Image Denoise (docs/denoising.md): headless, --out gets the denoised\n"
+                 "image and the raw beauty and the auxiliaries (albedo, normal) are layers of the EXR (--out\n"
+                 "itself, or OUT.layers.exr beside a .png or .pfm); in the viewer, the denoised view is on at start.\n"
+                 "Biased: it trades noise for blur");
+    std::string denoise_quality;
+    auto* dq_opt = app.add_option("--denoise-quality", denoise_quality,
+                                  "fast, balanced or high (OIDN's quality modes; default high headless, balanced "
+                                  "in the viewer)")
+                       ->check(CLI::IsMember({"fast", "balanced", "high"}));
+    bool aov_layers = false;
+    app.add_flag("--aov", aov_layers,
+                 "Render the denoiser's auxiliary images (albedo and normal of the first non-specular surface)\n"
+                 "and write them as layers albedo.R/G/B and normal.X/Y/Z of an .exr output");
     std::string priority;
     auto* prio_opt = app.add_option("--render-priority", priority,
                                     "Viewer: CPU priority of the render threads: idle (default for a window: the "
@@ -127,6 +141,9 @@ int main(int argc, char** argv) {
         if (*sampler_opt) ov.sampler = parse_sampler_name(sampler_name);
         if (*count_opt) ov.sample_count = sample_count;
         if (*i_opt) ov.integrator = parse_integrator_type(integrator);
+        if (*dq_opt) parse_denoise_quality(denoise_quality, opt.denoise_quality);
+        ov.denoise_aux = opt.denoise || aov_layers;
+        ov.denoise_box_filter = opt.denoise;
 
 #ifdef CANDELA_HAS_MPI
         // Under mpirun or srun every rank renders a share of one headless render.
@@ -144,6 +161,8 @@ int main(int argc, char** argv) {
             vo.threads = opt.threads;
             vo.display = opt.display;
             vo.spp_per_frame = opt.spp_per_frame;
+            vo.denoise = opt.denoise;
+            vo.denoise_quality = *dq_opt ? opt.denoise_quality : DenoiseQuality::Balanced;
             vo.screenshot_after = shot_args.first;
             vo.screenshot = shot_args.second;
             if (*prio_opt) vo.render_priority = parse_render_priority(priority);

@@ -584,6 +584,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
         std::fprintf(stderr, "candela: %s\n", e.what());
         return 1;
     }
+    if (!opt.quiet) print_denoise_summary(opt, scene, wi);
     if (!opt.quiet) {
         const double spp = double(total) / double(pixels);
         print_memory_summary(scene);
@@ -604,7 +605,7 @@ int run_headless_mpi(const HeadlessOptions& opt) {
         if (checkpointing && prefix > 0)
             std::fprintf(stderr, "candela: checkpoint %s at %u spp\n", opt.checkpoint.c_str(), prefix);
     }
-    if (wi.png_failed) return 1;
+    if (wi.png_failed || wi.denoise_failed) return 1;
     return stop_signal ? 128 + stop_signal : 0;
 }
 

@@ -36,12 +36,25 @@ std::vector<std::string> aov_channel_names(const std::vector<AovSpec>& aovs) {
             case AovType::PrimIndex:
             case AovType::ShapeIndex: sfx = i; break;
             case AovType::Uv: sfx = uv; break;
-            case AovType::Albedo: sfx = rgb; break;
+            case AovType::Albedo:
+            case AovType::DenoiseAlbedo: sfx = rgb; break;
             default: sfx = xyz; break;
         }
         for (int k = 0; k < aov_channel_count(a.type); ++k) names.push_back(a.name + sfx[k]);
     }
     return names;
+}
+
+void add_denoise_aovs(std::vector<AovSpec>& aovs) {
+    bool taken = false;
+    for (const AovSpec& a : aovs) {
+        if (a.type == AovType::DenoiseAlbedo || a.type == AovType::DenoiseNormal) return;
+        taken = taken || a.name == "albedo" || a.name == "normal";
+    }
+    const std::string prefix = taken ? "denoise_" : "";
+    auto at = aovs.end();
+    if (!aovs.empty() && aovs.back().type == AovType::Moment) --at;  // the moment channels stay last
+    aovs.insert(at, {{prefix + "albedo", AovType::DenoiseAlbedo}, {prefix + "normal", AovType::DenoiseNormal}});
 }
 
 bool parse_aov_type(const std::string& s, AovType& out) {

@@ -40,6 +40,11 @@ enum class AovType {
     DpDv,       // world-space dp/dv: ".X" ".Y" ".Z"
     PrimIndex,  // the triangle's index within its shape (0 on analytic shapes), as a float: ".I"
     ShapeIndex, // candela's shape index (Mitsuba writes an id of its own, not comparable): ".I"
+    // The denoiser's auxiliary images (candela's own, added by --denoise and --aov; docs/denoising.md):
+    // the camera ray followed through delta surfaces (mirrors, smooth glass) to the first surface
+    // with a non-delta component, as Open Image Denoise asks.
+    DenoiseAlbedo,  // that surface's albedo (as Albedo), clamped to [0, 1]: ".R" ".G" ".B"
+    DenoiseNormal,  // its shading normal (world, unit, facing the incoming ray): ".X" ".Y" ".Z"
     // Not an aov type: the `moment` wrapper's channels, always last. The nested integrator's
     // radiance per sample as CIE XYZ, then its square (the per-sample second moment), both filtered
     // like the image: "<name>.X" ".Y" ".Z" "m2_<name>.X" ".Y" ".Z" (Mitsuba's moment.cpp).
@@ -68,6 +73,10 @@ struct IntegratorDesc {
 int aov_channel_count(AovType t);
 int aov_channel_count(const std::vector<AovSpec>& aovs);
 std::vector<std::string> aov_channel_names(const std::vector<AovSpec>& aovs);
+// Adds the denoiser's layers (DenoiseAlbedo "albedo", DenoiseNormal "normal"; "denoise_albedo" and
+// "denoise_normal" when the scene's aov wrapper already has those names) before a moment spec,
+// unless they are there already.
+void add_denoise_aovs(std::vector<AovSpec>& aovs);
 // "depth", "position", ... (Mitsuba's names); false when `s` names no AOV candela computes.
 bool parse_aov_type(const std::string& s, AovType& out);
 

@@ -35,6 +35,7 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
             throw Error(std::string("--integrator ") + integrator_type_name(*ov.integrator) +
                         ": the scene's aov or moment integrator needs camera rays per pixel, which it does not trace");
     }
+    if (ov.denoise_aux && reads(st.integrator.type).aovs) add_denoise_aovs(st.integrator.aovs);
 }
 
 // What the integrator does not read (integrator/caps.h): an option given on the command line is
@@ -81,6 +82,12 @@ std::shared_ptr<const Scene> prepare_scene(const std::string& path, const SceneO
     SceneDescription desc = path.empty() ? make_cornell_box() : load_scene(path, ov.defines);
     apply_overrides(desc.settings, ov);
     check_reads(desc, ov);
+    if (ov.denoise_box_filter && !desc.settings.filter.is_box()) {
+        desc.warnings.push_back((path.empty() ? std::string("the scene") : path) + ": rendered with the box filter, not " +
+                                filter_name(desc.settings.filter.type) +
+                                ", for the denoiser (it keeps noise that a wider filter correlates between pixels)");
+        desc.settings.filter = FilterDesc{};
+    }
     return build_scene(std::move(desc), ov.accel);
 }
 

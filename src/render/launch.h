@@ -29,6 +29,15 @@ struct SceneOverrides {
     std::optional<int> sample_count;     // --sample-count: the scene's sample_count
     std::optional<IntegratorType> integrator;  // --integrator: replaces the scene's <integrator>
     std::string accel = "auto";
+    // --denoise, --aov: render the denoiser's auxiliary layers (add_denoise_aovs) when the
+    // integrator traces camera paths per pixel (path, direct); the others have none to follow, and
+    // their images are denoised from the beauty alone.
+    bool denoise_aux = false;
+    // --denoise, and the viewer when it can denoise: render with the box reconstruction filter
+    // (a warning says so when the scene asks for another). A wider filter spreads each sample over
+    // several pixels, so that the noise is correlated between neighbours; Open Image Denoise takes
+    // such noise for detail and keeps it (docs/denoising.md shows it on matpreview).
+    bool denoise_box_filter = false;
 };
 
 // Loads `path` (or the built-in Cornell box when empty), applies the overrides and builds the

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cmath>
 #include "core/error.h"
+#include "render/denoise_worker.h"
 #include "render/renderer.h"
 
 namespace candela {
@@ -215,6 +216,58 @@ void RenderSession::publish(const Film& film, bool preview, uint64_t gen, int pa
     if (notify) notify();
 }
 
+void RenderSession::set_denoise(bool on, DenoiseQuality q) {
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        if (on && !denoiser_)
+            denoiser_ = std::make_unique<DenoiseWorker>(q, opt_.priority != RenderPriority::Normal, [this] {
+                std::function<void()> notify;
+                {
+                    std::lock_guard<std::mutex> l(mu_);
+                    notify = on_publish_;
+                }
+                if (notify) notify();  // a denoised image is news for the front end too
+            });
+        if (denoiser_) denoiser_->set_quality(q);
+        denoise_request_ = on;  // the worker hands over the film it has
+        denoise_on_ = on;
+    }
+    cv_.notify_all();
+}
+
+bool RenderSession::denoise_on() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return denoise_on_;
+}
+
+bool RenderSession::take_denoised(SessionImage& img) {
+    DenoiseWorker* dw;
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        dw = denoiser_.get();  // never destroyed before the session
+    }
+    return dw && dw->take(img);
+}
+
+std::string RenderSession::denoise_error() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return denoiser_ ? denoiser_->error() : std::string();
+}
+
+double RenderSession::denoise_seconds() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return denoiser_ ? denoiser_->last_seconds() : 0.0;
+}
+
+bool RenderSession::wait_for_denoised(uint64_t gen, int passes, double timeout_seconds) {
+    DenoiseWorker* dw;
+    {
+        std::lock_guard<std::mutex> lock(mu_);
+        dw = denoiser_.get();
+    }
+    return dw && dw->wait_for(gen, passes, timeout_seconds);
+}
+
 RenderPriority parse_render_priority(const std::string& s) {
     if (s == "normal") return RenderPriority::Normal;
     if (s == "low") return RenderPriority::Low;
@@ -266,14 +319,27 @@ void RenderSession::worker() {
         return Job::Full;
     };
 
+    // Hands the full film to the denoiser when it is on (the film's images, resolved here).
+    auto submit_denoise = [&]() {
+        DenoiseWorker* dw = nullptr;
+        {
+            std::lock_guard<std::mutex> lock(mu_);
+            denoise_request_ = false;
+            if (denoise_on_) dw = denoiser_.get();
+        }
+        if (dw && passes > 0) dw->submit(denoise_inputs(full, scene->settings.integrator.aovs), gen, passes);
+    };
+
     for (;;) {
         std::unique_ptr<Pending> pending;
         Job job;
+        bool denoise_request = false;
         {
             std::unique_lock<std::mutex> lock(mu_);
             stats_.idle = true;
-            cv_.wait(lock, [&] { return quit_ || pending_ || next_job() != Job::None; });
+            cv_.wait(lock, [&] { return quit_ || pending_ || denoise_request_ || next_job() != Job::None; });
             if (quit_) return;
+            denoise_request = denoise_request_ && !pending_;
             if (pending_) {
                 pending = std::move(pending_);
                 gen = generation_;
@@ -327,6 +393,7 @@ void RenderSession::worker() {
             std::lock_guard<std::mutex> lock(mu_);
             job = next_job();
         }
+        if (denoise_request) submit_denoise();
         if (job == Job::None) continue;
 
         const bool is_preview = job == Job::Preview;
@@ -385,6 +452,7 @@ void RenderSession::worker() {
             s.change.push_back(float(change));
             s.change_time.push_back(float(render_time));
         });
+        submit_denoise();
     }
 }
 

@@ -25,6 +25,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include "denoise/denoiser.h"
 #include "film/film.h"
 #include "film/pass_halves.h"
 #include "scene/scene.h"
@@ -138,6 +139,20 @@ public:
     // image, preview included) is published, or the timeout expires. For tests and tools only.
     bool wait_for(uint64_t gen, int passes, double timeout_seconds);
 
+    // Denoising (docs/denoising.md). While on, every full pass's film is handed to a background
+    // denoiser (render/denoise_worker.h, its own thread, started on the first call), which keeps
+    // the newest; turning it on while the render rests hands over the film as it is. The scene's
+    // denoiser layers (SceneOverrides::denoise_aux) feed it albedo and normal.
+    void set_denoise(bool on, DenoiseQuality q);
+    bool denoise_on() const;
+    // Moves the newest denoised image into `img` when newer than img.sequence.
+    bool take_denoised(SessionImage& img);
+    // Why the last denoise failed (empty: it did not or none ran) and how long the last one took.
+    std::string denoise_error() const;
+    double denoise_seconds() const;
+    // As wait_for, for the denoised image; false too when a denoise failed.
+    bool wait_for_denoised(uint64_t gen, int passes, double timeout_seconds);
+
 private:
     struct Pending;
     void worker();
@@ -168,6 +183,8 @@ private:
     SessionStats stats_;
     std::function<void()> on_publish_;
     uint64_t published_generation_ = 0;
+    bool denoise_on_ = false, denoise_request_ = false;
+    std::unique_ptr<class DenoiseWorker> denoiser_;  // created by the first set_denoise(true)
 
     // The worker's own buffers (no lock): the next image to publish, the previous full pass.
     SessionImage back_;

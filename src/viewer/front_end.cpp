@@ -70,9 +70,21 @@ bool ViewerFrontEnd::begin_frame(double now) {
             set_status("loading " + path + " ...", false);
         }
     }
-    bool fresh = session_->take_image(image_);
+    session_->take_image(image_);
+    if (denoise_view_) session_->take_denoised(denoised_);
     stats_ = session_->stats();
-    return fresh;
+    // New to the screen: another image, or the same one switched between raw and denoised.
+    const SessionImage* shown = &image();
+    const bool fresh = shown != last_shown_ || shown->sequence != last_shown_sequence_;
+    last_shown_ = shown;
+    last_shown_sequence_ = shown->sequence;
+    return fresh && !shown->rgb.empty();
+}
+
+void ViewerFrontEnd::set_denoise_view(bool on, DenoiseQuality q) {
+    denoise_view_ = on;
+    denoise_quality_ = q;
+    session_->set_denoise(on, q);
 }
 
 void ViewerFrontEnd::end_frame(double now) {

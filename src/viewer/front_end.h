@@ -74,7 +74,18 @@ public:
 
     RenderSession& session() { return *session_; }
     const Scene& scene() const { return *scene_; }
-    const SessionImage& image() const { return image_; }
+    // The image on screen: the denoised film when the denoised view is on and the denoiser has
+    // caught up with the film's generation (the raw film until then, and during previews).
+    const SessionImage& image() const { return showing_denoised() ? denoised_ : image_; }
+    const SessionImage& raw_image() const { return image_; }
+    // The denoised view (docs/denoising.md): one toggle; the raw film is the other state.
+    void set_denoise_view(bool on, DenoiseQuality q);
+    bool denoise_view() const { return denoise_view_; }
+    DenoiseQuality denoise_quality() const { return denoise_quality_; }
+    bool showing_denoised() const {
+        return denoise_view_ && !denoised_.rgb.empty() && !image_.preview && denoised_.generation == image_.generation &&
+               denoised_.width == image_.width && denoised_.height == image_.height;
+    }
     const SessionStats& stats() const { return stats_; }
     int spp_per_pass() const { return spp_per_pass_; }
     const std::string& status() const { return status_; }
@@ -92,7 +103,12 @@ private:
     CameraController camera_;
     SceneOverrides drop_overrides_;
     int spp_per_pass_ = 1;
-    SessionImage image_;
+    SessionImage image_;     // the newest raw image
+    SessionImage denoised_;  // the newest denoised one
+    bool denoise_view_ = false;
+    DenoiseQuality denoise_quality_ = DenoiseQuality::Balanced;
+    const SessionImage* last_shown_ = nullptr;  // what begin_frame last reported
+    uint64_t last_shown_sequence_ = 0;
     SessionStats stats_;
 
     bool dirty_ = false;  // edited since the last update()

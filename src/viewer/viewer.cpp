@@ -46,7 +46,11 @@ Viewer::Viewer(const ViewerOptions& opt) : opt_(opt), display_(opt.display) {
 }
 
 void Viewer::init() {
-    const ViewerOptions& opt = opt_;
+    ViewerOptions& opt = opt_;
+    // The denoiser's albedo and normal cost a ray or more per sample, and its box filter changes
+    // the image: only when asked for (--denoise). Without them the toggle denoises the beauty alone.
+    denoise_unavailable_ = denoiser_unavailable_reason();
+    opt.overrides.denoise_aux = opt.overrides.denoise_box_filter = opt.denoise && denoise_unavailable_.empty();
     std::shared_ptr<const Scene> scene = prepare_scene(opt.scene, opt.overrides);
     for (const std::string& w : scene->warnings) std::fprintf(stderr, "candela: warning: %s\n", w.c_str());
     open_window(scene->settings.width, scene->settings.height);
@@ -66,6 +70,8 @@ void Viewer::init() {
     fe_->session().set_on_publish([] { glfwPostEmptyEvent(); });
     fe_->set_on_scene_switched([this] { glfwSetWindowTitle(window_, ("candela - " + fe_->scene().source).c_str()); });
     threads_ = fe_->session().threads();
+    if (opt.denoise && denoise_unavailable_.empty()) fe_->set_denoise_view(true, opt.denoise_quality);
+    if (opt.denoise && !denoise_unavailable_.empty()) fe_->set_status(denoise_unavailable_, true);
     if (opt_.hooks) opt_.hooks->started(*fe_);
 }
 

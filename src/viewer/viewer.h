@@ -40,6 +40,11 @@ struct ViewerOptions {
     // for --screenshot-after runs, where nobody is waiting on the window's frames.
     std::optional<RenderPriority> render_priority;
     ViewerHooks* hooks = nullptr;  // measuring tools only; frames are then paced without vsync
+    // The denoised view (docs/denoising.md): on at start, and its quality. With it the scene renders
+    // the denoiser's albedo and normal (with the box filter); without it the panel's toggle
+    // denoises the beauty alone, so that a scene that is never denoised pays nothing.
+    bool denoise = false;
+    DenoiseQuality denoise_quality = DenoiseQuality::Balanced;
 };
 
 // Thrown by run_viewer when GLFW cannot initialise (no display server, a refused connection) or

@@ -50,6 +50,7 @@ private:
     std::unique_ptr<ViewerFrontEnd> fe_;
     DisplaySettings display_;
     int threads_ = 1;
+    std::string denoise_unavailable_;  // why there is no denoised view (empty: there is one)
 
     // Mouse drags that started over the render area.
     int drag_button_ = -1;

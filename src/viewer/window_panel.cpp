@@ -71,6 +71,29 @@ void Viewer::panel() {
         if (stats.nonfinite > 0) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.4f, 0.35f, 1.f));
         ImGui::Text("NaN/Inf samples: %llu", (unsigned long long)stats.nonfinite);
         if (stats.nonfinite > 0) ImGui::PopStyleColor();
+        // The denoised view: display only (the render goes on, the toggle never restarts it).
+        if (denoise_unavailable_.empty()) {
+            bool dn = fe_->denoise_view();
+            int q = int(fe_->denoise_quality());
+            bool changed = ImGui::Checkbox("Denoised", &dn);
+            ImGui::SameLine();
+            ImGui::SetNextItemWidth(110.f);
+            changed |= ImGui::Combo("##dnq", &q, "fast\0balanced\0high\0");
+            if (changed) fe_->set_denoise_view(dn, DenoiseQuality(q));
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip("Open Image Denoise's quality mode (docs/denoising.md). Started with --denoise, the\n"
+                                  "render adds albedo and normal guides (box filter); otherwise the beauty alone is denoised.");
+            if (dn) {
+                const std::string err = fe_->session().denoise_error();
+                if (!err.empty()) ImGui::TextColored(ImVec4(1.f, 0.4f, 0.35f, 1.f), "%s", err.c_str());
+                else if (fe_->showing_denoised())
+                    ImGui::TextDisabled("denoised at %d passes in %.0f ms", fe_->image().passes,
+                                        fe_->session().denoise_seconds() * 1e3);
+                else ImGui::TextDisabled("raw film (denoising)");
+            }
+        } else {
+            ImGui::TextDisabled("no denoiser: %s", denoise_unavailable_.c_str());
+        }
         std::vector<float> curve = resample_log(stats.change, stats.change_time, 120);
         char overlay[64];
         std::snprintf(overlay, sizeof overlay, "rel. change/pass %.2e",

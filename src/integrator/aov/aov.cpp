@@ -1,4 +1,5 @@
 #include "integrator/aov/aov.h"
+#include <cstring>
 #include "integrator/shading.h"
 
 namespace candela {
@@ -12,6 +13,68 @@ vec3 diffuse_reflectance(const Bsdf& bsdf, vec3 wo_local) {
     if (const DiffuseBsdf* d = std::get_if<DiffuseBsdf>(&bsdf)) return d->albedo;
     if (const PrincipledBsdf* p = std::get_if<PrincipledBsdf>(&bsdf)) return p->base_color;
     return eval(bsdf, wo_local, vec3(0.f, 0.f, 1.f)) * kPi;
+}
+
+vec3 shading_reflectance(const ShadingT<false>& sh) {
+    // Mitsuba's blendbsdf returns the blend of its children's values, the other wrappers their
+    // nested BSDF's: the mixture of the leaves, unperturbed.
+    if (!sh.is_wrapped) return diffuse_reflectance(*sh.bsdf, sh.wo);
+    vec3 rho(0.f);
+    for (int k = 0; k < sh.wrapped.n; ++k) rho += sh.wrapped.w[size_t(k)] * diffuse_reflectance(*sh.wrapped.leaf[size_t(k)], sh.wo);
+    return rho;
+}
+
+// A well-mixed 64-bit value from a ray's bits (splitmix64's finaliser over each word).
+uint64_t hash_ray(const Ray& r) {
+    uint32_t w[6];
+    std::memcpy(w, &r.o, sizeof(float) * 3);
+    std::memcpy(w + 3, &r.d, sizeof(float) * 3);
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (uint32_t v : w) {
+        h ^= v;
+        h += 0x9e3779b97f4a7c15ull;
+        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+        h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+        h ^= h >> 31;
+    }
+    return h;
+}
+
+// At most this many delta bounces before the denoiser's features give up and take the surface
+// they are on (a hall of mirrors).
+constexpr int kMaxDeltaBounces = 16;
+
+// The denoiser's features: the camera ray followed through surfaces whose BSDF is all delta
+// lobes (mirrors, smooth glass, thin panes) to the first surface with a non-delta component, its
+// albedo (clamped to [0, 1], as OIDN requires) and shading normal. Which way glass sends the ray
+// (reflected or refracted, with the Fresnel probabilities of its own sampling) is drawn from a
+// hash of the ray, not from the sampler, so that the nested integrator's samples and image stay
+// the same; averaged over a pixel's samples this is the Fresnel blend OIDN's documentation asks
+// for. Zero albedo and normal where the ray leaves the scene.
+void denoise_features(const Scene& scene, Ray ray, Hit hit, vec3& albedo, vec3& normal, uint64_t* rays) {
+    albedo = normal = vec3(0.f);
+    ShadingT<false> sh;
+    for (int bounce = 0;; ++bounce) {
+        SurfaceInteraction si = scene.interaction(hit);
+        const vec3 d = glm::normalize(ray.d);
+        shade<false>(scene, hit, si, -d, sh);
+        if (sh.has_smooth_component() || bounce == kMaxDeltaBounces) {
+            albedo = glm::clamp(shading_reflectance(sh), vec3(0.f), vec3(1.f));
+            normal = sh.frame.n;
+            return;
+        }
+        const uint64_t h = hash_ray(ray);
+        const float u1 = float(h >> 40) * 0x1p-24f;
+        const vec2 u2(float((h >> 16) & 0xffffffu) * 0x1p-24f, float(h & 0xffffu) * 0x1p-16f);
+        const std::optional<BsdfSample> s = sh.sample(u1, u2);
+        if (!s) {  // a delta surface seen from a side where it reflects nothing
+            normal = sh.frame.n;
+            return;
+        }
+        ray = spawn_ray(si, sh.frame.to_world(s->wi));
+        ++*rays;
+        if (!scene.accel->intersect(ray, hit)) return;
+    }
 }
 
 }  // namespace
@@ -30,6 +93,8 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
     }
     const SurfaceInteraction si = scene.interaction(hit);
     const vec3 d = glm::normalize(ray.d);
+    vec3 feature_albedo, feature_normal;
+    bool features = false;  // computed once for both denoiser layers
     for (const AovSpec& a : aovs) {
         switch (a.type) {
             case AovType::Depth: *o++ = glm::dot(si.p - eye, d); break;
@@ -65,16 +130,19 @@ void eval_aovs(const Scene& scene, const std::vector<AovSpec>& aovs, vec3 eye, c
             case AovType::ShapeIndex: *o++ = float(si.shape); break;
             case AovType::Moment: o += aov_channel_count(AovType::Moment); break;  // write_moment's
             case AovType::Albedo: {
-                // Mitsuba's blendbsdf returns the blend of its children's values, the other
-                // wrappers their nested BSDF's: the mixture of the leaves, unperturbed.
                 SurfaceInteraction s = si;
                 ShadingT<false> sh;
                 shade<false>(scene, hit, s, -d, sh);
-                vec3 rho(0.f);
-                if (!sh.is_wrapped) rho = diffuse_reflectance(*sh.bsdf, sh.wo);
-                else
-                    for (int k = 0; k < sh.wrapped.n; ++k) rho += sh.wrapped.w[size_t(k)] * diffuse_reflectance(*sh.wrapped.leaf[size_t(k)], sh.wo);
+                const vec3 rho = shading_reflectance(sh);
                 for (int k = 0; k < 3; ++k) *o++ = rho[k];
+                break;
+            }
+            case AovType::DenoiseAlbedo:
+            case AovType::DenoiseNormal: {
+                if (!features) denoise_features(scene, ray, hit, feature_albedo, feature_normal, rays);
+                features = true;
+                const vec3 v = a.type == AovType::DenoiseAlbedo ? feature_albedo : feature_normal;
+                for (int k = 0; k < 3; ++k) *o++ = v[k];
                 break;
             }
         }
