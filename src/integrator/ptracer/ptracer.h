@@ -79,8 +79,10 @@ void LightTracer::visible_emitters(S& sampler, SplatTile& out, PathStats& stats,
     if (ps.light < 0) {
         CameraWiSample cs;
         if (!camera_.sample_wi(ps.si.p, u_lens, cs)) return;
-        const float cos_l = glm::dot(cs.wi, ps.si.ns);  // one-sided: the front only
-        if (!(cos_l > 0.f) || is_black(ps.Le)) return;
+        // One-sided: the front (the shading normal's side) only; the area measure's cosine is the
+        // geometric one (light/emitter.h).
+        if (!(glm::dot(cs.wi, ps.si.ns) > 0.f) || is_black(ps.Le)) return;
+        const float cos_l = std::abs(glm::dot(cs.wi, ps.si.ng));
         ++stats.rays;
         const float T = shadow_transmittance(sc, spawn_ray_to(ps.si, cs.p, vec3(0.f), vec3(0.f)), masks, stats.rays);
         if (!(T > 0.f)) return;
