@@ -174,7 +174,7 @@ bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) c
         if (glm::dot(out.wi, as.n) >= 0.f) return false;  // we see its back (one-sided)
         out.p = as.p;
         out.p_error = as.p_error;
-        out.n = as.n;
+        out.n = out.ns = as.n;
         out.Le = emitter_radiance_[size_t(analytic_emitter_[alights_[i - tris_.size()]])];
         out.pdf = pmf * as.pdf;
         return std::isfinite(out.pdf) && out.pdf > 0.f;
@@ -199,6 +199,7 @@ bool LightSet::sample_area_li(vec3 ref_p, float u1, vec2 u2, LightSample& out) c
     float cos_light = -glm::dot(out.wi, ng);
     if (glm::dot(out.wi, ns) >= 0.f || cos_light == 0.f) return false;  // we see its back
     out.n = ng;
+    out.ns = ns;
     // interpolate_point weighs p0, p1, p2 by (b.x, b.y, 1 - b.x - b.y).
     out.Le = emitter_texture_[size_t(tri_emitter_[tri])] ? triangle_radiance(tri, tri_emitter_[tri], b.y, 1.f - b.x - b.y)
                                                          : radiance_[i];
@@ -319,7 +320,7 @@ std::optional<EmissionSample> LightSet::sample_le(float u_sel, vec2 u_pos, vec2 
     vec3 d = f.to_world(local);
     if (!(local.z > 0.f)) return std::nullopt;
     es.ray = spawn_ray(ps.si, d);
-    es.n = ps.si.ns;
+    es.n = ps.si.ng;  // the estimate's |cos| is the geometric one (emitter.h)
     es.pdf_pos = ps.pdf;
     es.pdf_dir = square_to_cosine_hemisphere_pdf(local);
     if (on_light) *on_light = ps.si;

@@ -18,7 +18,13 @@
 //             the light, or on the disk of the scene's bounding sphere for directional and
 //             infinite lights, 1 for a delta position) and pdf_dir (solid angle, 1 for a delta
 //             direction), as pbrt-v4's Light::SampleLe; the estimate of a light path's start is
-//             Le |cos| / (pdf_pos pdf_dir).
+//             Le |cos| / (pdf_pos pdf_dir), cos against EmissionSample::n.
+//   Area lights with vertex normals: one convention everywhere. Their shading normal ns picks the
+//   emitting side (emitted(), sample_li, sample_le) and is the axis of sample_le's cosine-weighted
+//   direction (and of its pdf, pdf_le); every cosine of a measure (area to solid angle in
+//   sample_li / pdf_li, the |cos| of sample_le's estimate) is the GEOMETRIC one, so that all the
+//   strategies estimate what a ray hitting the light sees: radiance per unit of projected area of
+//   the actual surface (as the path tracer's BSDF sampling does, the unbiased witness).
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,6 +55,8 @@ struct SceneSphere {
 struct LightSample {
     vec3 p{0.f}, p_error{0.f};  // point on the light and its error bound (unused for infinite lights)
     vec3 n{0.f};                // geometric normal at p (zero for point and spot lights)
+    vec3 ns{0.f};               // area lights: the shading normal at p, whose side emits (= n on flat
+                                // shapes); unused by the other lights
     vec3 wi{0.f};               // unit direction from the reference point to p
     float dist = 0.f;           // distance from the reference point to p (infinity: infinite light)
     vec3 Le{0.f};               // see "Li" above
@@ -61,7 +69,11 @@ struct LightSample {
 // A ray leaving a light (see "sample_le" above).
 struct EmissionSample {
     Ray ray;
-    vec3 n{0.f};      // normal at the ray's origin (area: the light's; directional/infinite: ray.d; else 0)
+    // Normal at the ray's origin, for the |cos| of the estimate: area lights: the GEOMETRIC normal
+    // (radiance is per unit of projected surface, as the rays that hit the light see it; the
+    // direction is cosine-distributed about the shading normal, the emitting side);
+    // directional/infinite: ray.d; else 0.
+    vec3 n{0.f};
     vec3 Le{0.f};
     float pdf_pos = 0.f, pdf_dir = 0.f;  // include the pmf of the light's choice in pdf_pos
     uint32_t flags = 0;

@@ -104,6 +104,62 @@ std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c) {
     return sc;
 }
 
+namespace {
+
+// The diffuse box of smooth_ball_description, the lamp's material and an emitter of radiance L,
+// and the camera.
+SceneDescription open_box(int res, float L) {
+    SceneDescription d;
+    d.source = "<open box>";
+    d.materials.push_back(Material{"white", DiffuseBsdf{vec3(0.6f)}, false});
+    d.materials.push_back(Material{"red", DiffuseBsdf{vec3(0.6f, 0.15f, 0.1f)}, false});
+    d.materials.push_back(Material{"green", DiffuseBsdf{vec3(0.1f, 0.5f, 0.15f)}, false});
+    d.materials.push_back(Material{"lamp", DiffuseBsdf{vec3(0.f)}, false});
+    d.emitters.push_back(AreaEmitter{vec3(L)});
+    // A quad from corner o along a and b, facing cross(a, b) (into the box).
+    auto quad = [&](const char* name, vec3 o, vec3 a, vec3 b, uint32_t material) {
+        d.add_shape(name, {o, o + a, o + a + b, o + b}, {}, {uvec3(0, 1, 2), uvec3(0, 2, 3)}, material, -1);
+    };
+    quad("floor", vec3(-3, 0, -3), vec3(0, 0, 6), vec3(6, 0, 0), 0);
+    quad("back", vec3(-3, 0, -3), vec3(6, 0, 0), vec3(0, 5, 0), 0);
+    quad("left", vec3(-3, 0, -3), vec3(0, 5, 0), vec3(0, 0, 6), 1);
+    quad("right", vec3(3, 0, -3), vec3(0, 0, 6), vec3(0, 5, 0), 2);
+    d.settings.width = d.settings.height = res;
+    d.camera.to_world = look_at(vec3(0.f, 2.2f, 6.5f), vec3(0.f, 1.4f, -1.f), vec3(0.f, 1.f, 0.f));
+    d.camera.fov_deg = 60.f;
+    return d;
+}
+
+}  // namespace
+
+SceneDescription smooth_ball_description(int res) {
+    SceneDescription d = open_box(res, 4.f);
+    d.source = "<smooth ball light>";
+    std::vector<dvec3> v;
+    std::vector<glm::uvec3> f;
+    icosphere(0, v, f);
+    for (glm::uvec3& t : f) std::swap(t.y, t.z);  // icosphere() winds inwards: outwards here
+    const vec3 centre(0.6f, 2.f, -0.8f);
+    std::vector<vec3> pos, nrm;
+    for (const dvec3& p : v) {
+        pos.push_back(centre + 0.7f * vec3(p));
+        nrm.push_back(vec3(p));  // the sphere's normal: smooth shading over the 20 flat faces
+    }
+    d.add_shape("ball", pos, nrm, f, 3, 0);
+    return d;
+}
+
+SceneDescription tilted_lamp_description(int res) {
+    SceneDescription d = open_box(res, 8.f);
+    d.source = "<tilted-normal lamp>";
+    const float a = glm::radians(40.f);
+    const vec3 n(std::sin(a), -std::cos(a), 0.f);
+    const vec3 o(-0.6f, 4.f, -1.6f);
+    d.add_shape("lamp", {o, o + vec3(1.2f, 0, 0), o + vec3(1.2f, 0, 1.2f), o + vec3(0, 0, 1.2f)}, {n, n, n, n},
+                {uvec3(0, 1, 2), uvec3(0, 2, 3)}, 3, 0);
+    return d;
+}
+
 dvec3 expect_furnace_exact(const FurnaceConfig& c, double level) {
     auto sc = build_scene(std::move(*furnace_description(c)), "brute");
     Film film(c.res, c.res);

@@ -53,4 +53,17 @@ std::unique_ptr<SceneDescription> furnace_description(const FurnaceConfig& c);
 // and the standard error below 1% of the value; printed. Returns the z statistics per channel.
 glm::dvec3 expect_furnace_exact(const FurnaceConfig& c, double level);
 
+// ---- a smooth-shaded emitter ----------------------------------------------------------------
+// A 20-face ball light (the icosahedron, radius 0.7, radiance 4) with the vertex normals of the
+// sphere it approximates, in a diffuse box open at the front and the top (floor, back wall, a red
+// left wall, a green right wall), res x res pixels. The emitter's shading normals differ from its
+// geometric ones by up to 37 degrees: what tells apart the normal conventions of the strategies
+// that start or end on it (docs/bdpt.md).
+SceneDescription smooth_ball_description(int res);
+// The same box lit instead by a 1.2 x 1.2 square lamp under its open top (y = 4, facing down, the
+// radiance 8), whose vertex normals are all tilted by 40 degrees towards +x: emission on the
+// shading normals' side, but the surface is flat, so the emitted power follows the geometric
+// cosine (what a ray hitting the lamp sees), not the shading one.
+SceneDescription tilted_lamp_description(int res);
+
 }  // namespace candela::test

@@ -144,10 +144,14 @@ vec3 Bdpt::connect(const Workspace& ws, int s, int t, float u_l, vec2 u_p, vec2 
         sampled.w = -ls.wi;
         sampled.infinite = ls.infinite;
         sampled.delta_light = ls.delta;
-        if (ls.light < 0) {  // an area light: pdf_le and pdf_li need the point's interaction
+        if (ls.light < 0) {  // an area light: pdf_light and pdf_li need the point's interaction
             sampled.si.p = ls.p;
             sampled.si.p_error = ls.p_error;
-            sampled.si.ng = sampled.si.ns = ls.n;
+            // Both normals, as the other strategies' emitter vertices carry them (from sample_le or
+            // a hit): the direction density is about the shading normal, the measures' cosines
+            // are geometric (light/emitter.h).
+            sampled.si.ng = ls.n;
+            sampled.si.ns = ls.ns;
         }
         // The origin density (pdf_light_origin), here straight from the sample.
         if (ls.delta) sampled.pdf_fwd = sc.lights.choice_pmf();

@@ -7,12 +7,14 @@
 // pixel that started a path is only its owner for seeding and ordering. Per light path:
 //  1. Emitters seen directly (unless hide_emitters; Mitsuba's sample_visible_emitters): a point on
 //     a light chosen as for emission, connected to the camera. Area lights: a point uniform by
-//     area, estimate Le(y -> camera) cos_y Wi / (pdf_wi pdf_area). Infinite lights (constant,
+//     area, estimate Le(y -> camera) cos_y Wi / (pdf_wi pdf_area), cos_y the geometric cosine
+//     (light/emitter.h: the normals of emitters with vertex normals). Infinite lights (constant,
 //     envmap): a direction sampled as for next-event estimation from the camera, estimate
 //     Le We cos_cam lens_area / pdf_sa when the ray from the camera escapes (not for the
 //     orthographic camera, whose single direction no sampled direction hits). Delta lights are
 //     never seen directly: their choice contributes nothing here.
-//  2. A ray from the lights (LightSet::sample_le), throughput beta = Le |cos| / (pdf_pos pdf_dir).
+//  2. A ray from the lights (LightSet::sample_le), throughput beta = Le |cos| / (pdf_pos pdf_dir),
+//     cos against EmissionSample::n (area lights: the geometric normal).
 //     At every surface vertex x_k (k = scattering events, 1 at the first hit) with k <= max_depth:
 //     the camera connection (Camera::sample_wi) splats
 //         beta f(wo, wi_cam) |cos| C(wo, wi_cam) Wi / pdf_wi x visibility
@@ -79,8 +81,10 @@ void LightTracer::visible_emitters(S& sampler, SplatTile& out, PathStats& stats,
     if (ps.light < 0) {
         CameraWiSample cs;
         if (!camera_.sample_wi(ps.si.p, u_lens, cs)) return;
-        const float cos_l = glm::dot(cs.wi, ps.si.ns);  // one-sided: the front only
-        if (!(cos_l > 0.f) || is_black(ps.Le)) return;
+        // One-sided: the front (the shading normal's side) only; the area measure's cosine is the
+        // geometric one (light/emitter.h).
+        if (!(glm::dot(cs.wi, ps.si.ns) > 0.f) || is_black(ps.Le)) return;
+        const float cos_l = std::abs(glm::dot(cs.wi, ps.si.ng));
         ++stats.rays;
         const float T = shadow_transmittance(sc, spawn_ray_to(ps.si, cs.p, vec3(0.f), vec3(0.f)), masks, stats.rays);
         if (!(T > 0.f)) return;
