@@ -213,6 +213,13 @@ void agreement(const Scene& scene, const MltParams& m, int K, int mlt_spp, int r
     EXPECT_LT(p_ctl, kAlpha) << "the 3% brighter control is not rejected";
 }
 
+double image_mean(const Film& f) {
+    double s = 0;
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) s += double(luminance(f.pixel(x, y)));
+    return s / (double(f.width()) * double(f.height()));
+}
+
 bool films_equal(const Film& a, const Film& b) {
     if (a.splat_sums().size() != b.splat_sums().size() || a.splat_paths() != b.splat_paths()) return false;
     if (!a.splat_sums().empty() &&
@@ -277,13 +284,14 @@ TEST(Mlt, BootstrapMatchesPathTracer) {
 }
 
 TEST(Mlt, MmltBootstrapMatchesPathTracer) {
-    bootstrap_agreement(*cornell(32, 5), 200000, IntegratorType::Path, 12, 16, IntegratorType::Mmlt);
+    // 40000 paths per depth, 6 depths.
+    bootstrap_agreement(*cornell(32, 5), 40000, IntegratorType::Path, 12, 16, IntegratorType::Mmlt);
 }
 
 TEST(Mlt, MmltAgreesWithPathOnTheCornellBox) {
     auto scene = cornell(32, 5);
     MltParams m;
-    m.bootstrap_samples = 100000;  // b's spread per path is larger than pssmlt's (one strategy x their count)
+    m.bootstrap_samples = 20000;  // per depth (6 depths): b's spread per path is larger than pssmlt's
     m.chains = 2048;
     agreement(*scene, m, 16, 48, 32, 16, IntegratorType::Path, IntegratorType::Mmlt);
 }
@@ -316,7 +324,7 @@ TEST(Mlt, AgreesWithPathOnTheMirrorGlassBox) {
 TEST(Mlt, MmltAgreesWithBdptOnTheMirrorGlassBox) {
     auto scene = mirror_glass(32, 5);
     MltParams m;
-    m.bootstrap_samples = 100000;
+    m.bootstrap_samples = 20000;  // per depth (6 depths)
     m.chains = 16384;
     agreement(*scene, m, 16, 160, 16, 16, IntegratorType::Bdpt, IntegratorType::Mmlt);
 }
@@ -326,7 +334,7 @@ void determinism(IntegratorType type) {
     auto scene = cornell(24, type == IntegratorType::Mmlt ? 4 : -1);
     MltParams m;
     m.bootstrap_samples = 4000;
-    m.chains = 37;  // not a divisor of the pixel count: uneven shares
+    m.chains = 37;  // not a divisor of the pixel count: uneven shares (rotating between indices)
     auto sc = with(*scene, type, 9, &m);
     Film one(24, 24), two(24, 24), split(24, 24), replayed(24, 24);
     Renderer::render_pass(*sc, one, 0, 4, 1);
@@ -344,6 +352,15 @@ void determinism(IntegratorType type) {
     EXPECT_FALSE(films_equal(one, other));
     EXPECT_EQ(one.splat_paths(), uint64_t(4 * 24 * 24));
     EXPECT_EQ(one.nonfinite_count(), 0u);
+    // The film's mean is the mean of the b its indices used; the image shown, the latest b,
+    // refined by the large steps.
+    const MltStats st = pssmlt_stats();
+    Film shown;
+    mlt_output(one, st, shown);
+    EXPECT_NEAR(image_mean(one), st.b_image, 1e-5 * st.b);
+    EXPECT_NEAR(image_mean(shown), st.b, 1e-5 * st.b);
+    EXPECT_GT(st.large_steps, 0u);
+    EXPECT_NE(st.b, st.b_bootstrap);
 }
 }  // namespace
 
@@ -384,4 +401,183 @@ TEST(Mlt, Xml) {
     EXPECT_EQ(mm.settings.integrator.type, IntegratorType::Mmlt);
     EXPECT_EQ(mm.settings.max_depth, 5);
     EXPECT_EQ(mm.settings.integrator.mlt.chains, 9);
+}
+
+// ---- MMLT's brightness (issue 41) ---------------------------------------------------------------
+
+// The stratified allocation: proportional within one unit, every positive weight served, zero
+// weights not, the total exact.
+TEST(Mlt, StratifiedAllocation) {
+    const std::vector<double> w = {0.0, 3.0, 1.0, 0.001, 2.0, 0.0, 0.5};
+    const double sum = 6.501;
+    for (uint64_t total : {5ull, 7ull, 13ull, 1000ull, 1001ull, 65536ull}) {
+        const std::vector<uint64_t> a = mlt_allocate(w, total);
+        uint64_t got = 0;
+        for (size_t i = 0; i < w.size(); ++i) {
+            got += a[i];
+            if (w[i] == 0) EXPECT_EQ(a[i], 0u);
+            else EXPECT_GE(a[i], 1u) << "total " << total << " weight " << i;
+            // Within one unit of its share, plus the one unit the tiny weight may take from the largest.
+            EXPECT_LT(std::abs(double(a[i]) - w[i] / sum * double(total)), 2.0);
+        }
+        EXPECT_EQ(got, total);
+        EXPECT_EQ(a, mlt_allocate(w, total));
+    }
+    // Fewer units than positive weights: the largest get one each.
+    const std::vector<uint64_t> few = mlt_allocate(w, 2);
+    EXPECT_EQ(few, (std::vector<uint64_t>{0, 1, 0, 0, 1, 0, 0}));
+    EXPECT_EQ(mlt_allocate({0.0, 0.0}, 10), (std::vector<uint64_t>{0, 0}));
+    // Exact proportions stay exact.
+    EXPECT_EQ(mlt_allocate({1.0, 2.0, 1.0}, 1000), (std::vector<uint64_t>{250, 500, 250}));
+}
+
+// Each depth's b_d (its own bootstrap paths, not a share) against the path tracer's contribution
+// of exactly that many scattering events: the difference of its images at max depth d and d - 1,
+// 12 seeds each. Control: b_d 10% high is rejected (at the depth with the smallest relative error).
+TEST(Mlt, MmltDepthEstimatesMatchPathTracer) {
+    constexpr int kDepth = 3, K = 12, spp = 16, res = 32;
+    auto scene = cornell(res, kDepth);
+    MltParams m;
+    m.bootstrap_samples = 40000;
+    const MltStats bs = pssmlt_bootstrap(*with(*scene, IntegratorType::Mmlt, 5, &m), res, res, 2);
+    ASSERT_EQ(bs.b_depth.size(), size_t(kDepth + 1));
+    EXPECT_EQ(bs.b_depth[0], 0.0);  // hidden emitters
+    RunningStats prev;  // max depth 0: nothing (the lamp is hidden)
+    for (int k = 0; k < K; ++k) prev.add(0.0);
+    double p_min = 1, p_ctl = 1;
+    for (int d = 1; d <= kDepth; ++d) {
+        RunningStats cur;
+        auto sd = cornell(res, d);
+        for (int k = 0; k < K; ++k) {
+            Film f(res, res);
+            Renderer::render_pass(*with(*sd, IntegratorType::Path, uint64_t(k) + 1 + uint64_t(d) * 100), f, 0, spp, 2);
+            double s = 0;
+            for (int y = 0; y < res; ++y)
+                for (int x = 0; x < res; ++x) s += double(luminance(f.pixel(x, y)));
+            cur.add(s / double(res * res));
+        }
+        const double ref = cur.mean() - prev.mean(), ref_se = std::sqrt(sqr(cur.std_error()) + sqr(prev.std_error()));
+        const MeanTest z = z_test(bs.b_depth[size_t(d)], std::hypot(bs.b_depth_std_error[size_t(d)], ref_se), ref);
+        const MeanTest c = z_test(bs.b_depth[size_t(d)] * 1.1, std::hypot(bs.b_depth_std_error[size_t(d)] * 1.1, ref_se), ref);
+        std::printf("  depth %d: b_d = %.5f +- %.5f, path tracer %.5f +- %.5f: %s; 10%% high: %s\n", d, bs.b_depth[size_t(d)],
+                    bs.b_depth_std_error[size_t(d)], ref, ref_se, z.describe().c_str(), c.describe().c_str());
+        p_min = std::min(p_min, z.p_value);
+        p_ctl = std::min(p_ctl, c.p_value);
+        prev = cur;
+    }
+    EXPECT_GE(sidak_adjust(p_min, kDepth), kAlpha);
+    EXPECT_LT(p_ctl, kAlpha) << "b_d 10% high is not rejected at any depth";
+}
+
+// The spread of MMLT's image mean over seeds against the standard error it reports (issue 41), on
+// the Veach MIS scene with its lights in view (48 x 32, max depth 3: 4 depths of 40000 bootstrap
+// paths each). The image's mean is the latest b (mlt_output). Over the K seeds, sum((m_k -
+// mean)^2) / mean(se^2) is chi-square with K - 1 dof when the errors are what is reported (control:
+// a third of the reported error is rejected); the seeds' mean against the path tracer's. The
+// smallest light is hit by few uniform paths (per-path relative spread about 37 at depth 0): with
+// fewer paths most seeds miss it and their reported error misses it too (1000 paths per depth:
+// errors 0.018 at 8 mutations per pixel, 0.051 at 32 once the large steps found it).
+TEST(Mlt, MmltBrightnessSpreadMatchesItsError) {
+    constexpr int K = 8, w = 48, h = 32;
+    SceneDescription desc = load_scene(std::string(CANDELA_SOURCE_DIR) + "/scenes/veach-mis/scene.xml");
+    desc.settings.width = w;
+    desc.settings.height = h;
+    desc.settings.max_depth = 3;
+    auto scene = build_scene(std::move(desc), "auto");
+    MltParams m;
+    m.bootstrap_samples = 40000;
+    m.chains = 256;
+    RunningStats means;
+    double se2 = 0;
+    for (int k = 0; k < K; ++k) {
+        Film f(w, h);
+        Renderer::render_pass(*with(*scene, IntegratorType::Mmlt, uint64_t(k) + 1, &m), f, 0, 4, 2);
+        const MltStats st = pssmlt_stats();
+        Film shown;
+        mlt_output(f, st, shown);
+        EXPECT_NEAR(image_mean(shown), st.b, 1e-5 * st.b);
+        means.add(image_mean(shown));
+        se2 += sqr(st.b_std_error) / K;
+    }
+    RunningStats pt;
+    for (int k = 0; k < K; ++k) {
+        Film f(w, h);
+        Renderer::render_pass(*with(*scene, IntegratorType::Path, uint64_t(k) + 101), f, 0, 32, 2);
+        pt.add(image_mean(f));
+    }
+    const double chi2 = means.variance() * (K - 1) / se2, chi2_ctl = chi2 * 9;
+    const double p = chi_square_sf(chi2, K - 1), p_ctl = chi_square_sf(chi2_ctl, K - 1);
+    const MeanTest z = z_test(means.mean(), std::sqrt(se2 / K + sqr(pt.std_error())), pt.mean());
+    std::printf("  image mean over %d seeds %.5f, sd %.5f (%.1f%%); reported se %.5f (%.1f%%): chi2 %.2f (%d dof) p = %.3g, "
+                "errors / 3: p = %.3g\n  path tracer %.5f +- %.5f: %s\n",
+                K, means.mean(), std::sqrt(means.variance()), 100 * std::sqrt(means.variance()) / means.mean(),
+                std::sqrt(se2), 100 * std::sqrt(se2) / means.mean(), chi2, K - 1, p, p_ctl, pt.mean(), pt.std_error(),
+                z.describe().c_str());
+    EXPECT_GE(p, kAlpha) << "the image's brightness varies more over seeds than its reported error";
+    EXPECT_LT(p_ctl, kAlpha) << "a third of the reported error is not rejected";
+    EXPECT_GE(z.p_value, kAlpha);
+}
+
+namespace {
+double mlt_mean(const Film& f, const MltStats& st) {
+    Film shown;
+    mlt_output(f, st, shown);
+    return image_mean(shown);
+}
+}  // namespace
+
+// The brightness converges as the chains run (issue 41: before, the image's mean was the
+// bootstrap's b whatever the mutations). Cornell box 16 x 16, hidden lamp, max depth 3, a small
+// bootstrap (500 paths per depth, 2000 in all) and 64 mutations per pixel (4900 large steps): b's
+// reported error must fall by more than 1.4 from the first index to the last (sqrt(6900 / 2000) =
+// 1.86 if the per-path spread stayed), and the image's mean (the latest b, mlt_output) over 12
+// seeds must spread as that error says (chi-square on K - 1 dof; control: a third of the error
+// rejected) about the path tracer's mean.
+TEST(Mlt, MmltBrightnessConvergesWithTheMutations) {
+    constexpr int K = 12, res = 16;
+    auto scene = cornell(res, 3);
+    MltParams m;
+    m.bootstrap_samples = 500;
+    m.chains = 64;
+    RunningStats means;
+    double se2_boot = 0, se2 = 0;
+    for (int k = 0; k < K; ++k) {
+        Film f(res, res);
+        auto sc = with(*scene, IntegratorType::Mmlt, uint64_t(k) + 1, &m);
+        Renderer::render_pass(*sc, f, 0, 1, 2);
+        se2_boot += sqr(pssmlt_stats().b_std_error) / K;
+        Renderer::render_pass(*sc, f, 1, 63, 2);
+        const MltStats st = pssmlt_stats();
+        means.add(mlt_mean(f, st));
+        se2 += sqr(st.b_std_error) / K;
+    }
+    RunningStats pt;
+    for (int k = 0; k < K; ++k) {
+        Film f(res, res);
+        Renderer::render_pass(*with(*scene, IntegratorType::Path, uint64_t(k) + 101), f, 0, 64, 2);
+        pt.add(image_mean(f));
+    }
+    const double chi2 = means.variance() * (K - 1) / se2, chi2_ctl = chi2 * 9;
+    const double p = chi_square_sf(chi2, K - 1), p_ctl = chi_square_sf(chi2_ctl, K - 1);
+    const MeanTest z = z_test(means.mean(), std::sqrt(se2 / K + sqr(pt.std_error())), pt.mean());
+    const double shrink = std::sqrt(se2_boot / se2);
+    std::printf("  b's reported error after 1 and 64 mutations per pixel: %.5f, %.5f (ratio %.2f)\n"
+                "  image mean over %d seeds %.5f, sd %.5f (%.1f%%); reported se %.5f (%.1f%%): chi2 %.2f (%d dof) p = %.3g, "
+                "errors / 3: p = %.3g\n  path tracer %.5f +- %.5f: %s\n",
+                std::sqrt(se2_boot), std::sqrt(se2), shrink, K, means.mean(), std::sqrt(means.variance()),
+                100 * std::sqrt(means.variance()) / means.mean(), std::sqrt(se2), 100 * std::sqrt(se2) / means.mean(), chi2,
+                K - 1, p, p_ctl, pt.mean(), pt.std_error(), z.describe().c_str());
+    EXPECT_GT(shrink, 1.4) << "b's error does not shrink as the chains run";
+    EXPECT_GE(p, 0.01) << "the image's brightness varies more over seeds than its reported error";
+    EXPECT_LT(p_ctl, 0.01) << "a third of the reported error is not rejected";
+    EXPECT_GE(z.p_value, 0.01);
+}
+
+TEST(Mlt, MmltDepthNote) {
+    EXPECT_EQ(mmlt_depths(5), 6);
+    EXPECT_EQ(mmlt_depths(30), 31);  // an explicit depth is honoured (issue 41: it was capped at 12)
+    EXPECT_EQ(mmlt_depths(-1), kMmltUnboundedDepth + 1);
+    EXPECT_TRUE(mmlt_depth_note(30).empty());
+    EXPECT_NE(mmlt_depth_note(-1).find("unbounded"), std::string::npos);
+    EXPECT_FALSE(mmlt_depth_note(1000).empty());
 }

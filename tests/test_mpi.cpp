@@ -238,6 +238,15 @@ TEST(Mpi, TimeLimitAndSetupErrors) {
     EXPECT_NE(adaptive.exit_code, 0);
     EXPECT_NE(adaptive.output.find("--target-error is not available under MPI"), std::string::npos) << adaptive.output;
     EXPECT_FALSE(std::filesystem::exists(d + "/a.exr"));
+    // MLT's chains run from one sample index to the next: refused in one line at any rank count
+    // (before issue 41 each rank replayed the others' mutations).
+    for (const char* mlt : {"pssmlt", "mmlt"}) {
+        RunResult r = run_mpi(2, std::string("--width 16 --height 16 --threads 1 --quiet --integrator ") + mlt + " --out " + d + "/m.exr");
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_NE(r.output.find(std::string(mlt) + " does not run under MPI"), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("candela:", r.output.find("candela:") + 1), std::string::npos) << r.output;
+        EXPECT_FALSE(std::filesystem::exists(d + "/m.exr"));
+    }
 }
 
 #endif  // CANDELA_HAS_MPI

@@ -20,6 +20,7 @@
 #include "film/film.h"
 #include "film/image_io.h"
 #include "integrator/bdpt/bdpt.h"
+#include "integrator/mlt/pssmlt.h"
 #include "film/image_io.h"
 #include "headless/headless.h"
 #include "render/renderer.h"
@@ -211,6 +212,9 @@ int run_headless(const HeadlessOptions& opt) {
     const RenderSettings& st = scene.settings;
     if (!opt.quiet)
         for (const std::string& w : scene.warnings) std::fprintf(stderr, "candela: warning: %s\n", w.c_str());
+    const bool mlt = st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt;
+    if (!opt.quiet && st.integrator.type == IntegratorType::Mmlt && !mmlt_depth_note(st.max_depth).empty())
+        std::fprintf(stderr, "candela: %s\n", mmlt_depth_note(st.max_depth).c_str());
     const int spp_per_pass = std::max(1, opt.spp_per_frame);
     const uint64_t frames = opt.frames > 0 ? uint64_t(opt.frames) : uint64_t(std::max(1, st.spp / spp_per_pass));
     // Sample indices and per-pixel counts are 32-bit.
@@ -342,7 +346,12 @@ int run_headless(const HeadlessOptions& opt) {
     }
     if (checkpointing && whole_passes) save("final");
 
-    const WrittenImage wi = write_headless_image(opt, scene, film);
+    // MLT: the image is the film with its splats scaled to the latest b (the film, which a
+    // checkpoint keeps, is the sum of per-index layers, each at the b of its time).
+    const MltStats ms = mlt ? pssmlt_stats() : MltStats{};
+    Film shown;
+    if (mlt) mlt_output(film, ms, shown);
+    const WrittenImage wi = write_headless_image(opt, scene, mlt ? shown : film);
     if (!opt.bdpt_strategies.empty() && !g_signal.load()) write_bdpt_strategies(opt, scene, film, threads);
     const std::string& written = wi.path;
     const bool png_failed = wi.png_failed;
@@ -352,12 +361,32 @@ int run_headless(const HeadlessOptions& opt) {
         double spp = double(film.total_samples()) / (double(film.width()) * film.height());
         // Memory first: scripts read the summary from the last line.
         print_memory_summary(scene);
+        // MLT: the throughput is that of the mutations, the bootstrap's time apart; b (the image's
+        // mean luminance, which scales it) with its standard error.
+        std::string rate;
+        char buf[256];
+        if (mlt && ms.valid) {
+            const double start = ms.bootstrap_seconds + ms.replay_seconds, t = secs - start;
+            const double rel = ms.b > 0 ? ms.b_std_error / ms.b : 0.0;
+            if (rel > 0.01)
+                std::fprintf(stderr, "candela: warning: b (the image's brightness) has a relative standard error of %.1f%% "
+                                     "(above 1%%): raise bootstrap_samples or render longer\n", 100 * rel);
+            char replay[64] = "";
+            if (ms.replay_seconds > 0) std::snprintf(replay, sizeof replay, " and a %.2f s replay", ms.replay_seconds);
+            std::snprintf(buf, sizeof buf, "%.3f Mmutations/s after a %.2f s bootstrap (%llu paths)%s, b %.5g +- %.2g (%.2f%%)",
+                          t > 0 ? samples / t * 1e-6 : 0.0, ms.bootstrap_seconds, (unsigned long long)ms.bootstrap_paths,
+                          replay, ms.b, ms.b_std_error, 100 * rel);
+            rate = buf;
+        } else {
+            std::snprintf(buf, sizeof buf, "%.3f Msamples/s", secs > 0 ? samples / secs * 1e-6 : 0.0);
+            rate = buf;
+        }
         std::fprintf(stderr,
-                     "candela: %s%s %dx%d, %s, %.6g spp in %.2f s, %.3f Msamples/s, %.3f Mrays/s, %d threads, "
+                     "candela: %s%s %dx%d, %s, %.6g spp in %.2f s, %s, %.3f Mrays/s, %d threads, "
                      "accel %s, %llu non-finite samples -> %s\n",
                      sig ? (sig == SIGTERM ? "terminated: " : "interrupted: ") : stopped_by_limit ? "time limit: " : "",
                      scene.source.c_str(), film.width(),
-                     film.height(), integrator_summary(st).c_str(), spp, secs, secs > 0 ? samples / secs * 1e-6 : 0.0,
+                     film.height(), integrator_summary(st).c_str(), spp, secs, rate.c_str(),
                      secs > 0 ? rays / secs * 1e-6 : 0.0, threads, scene.accel->name().c_str(),
                      (unsigned long long)film.nonfinite_count(), written.c_str());
         if (adaptive) {

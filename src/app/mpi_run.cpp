@@ -22,6 +22,7 @@
 #include "core/interrupt.h"
 #include "core/progress.h"
 #include "film/image_io.h"
+#include "render/launch.h"
 #include "render/renderer.h"
 
 namespace candela {
@@ -283,6 +284,12 @@ int run_headless_mpi(const HeadlessOptions& opt) {
         scene_ptr = prepare_scene(opt.scene, opt.overrides);
         const RenderSettings& st = scene_ptr->settings;
         check_run_features(st, {true, false, !opt.checkpoint.empty() || !opt.resume.empty(), opt.time_limit > 0});
+        // MLT's chains carry state from one sample index to the next, and its film is scaled by a b
+        // refined as they run: sample indices cannot go to ranks independently (docs/distributed.md).
+        if (st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt)
+            throw Error(std::string(integrator_type_name(st.integrator.type)) +
+                        " does not run under MPI (its Markov chains run from one sample index to the next): render it "
+                        "in one process, without mpirun");
         chunk = uint32_t(std::max(1, opt.spp_per_frame));
         const uint64_t frames = opt.frames > 0 ? uint64_t(opt.frames) : uint64_t(std::max(1, st.spp / int(chunk)));
         const uint64_t t = frames * uint64_t(chunk);

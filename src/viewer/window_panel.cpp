@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iterator>
 #include <cstdio>
+#include <numeric>
 #include <thread>
 #include "integrator/caps.h"
 #include "integrator/mlt/pssmlt.h"
@@ -131,16 +132,19 @@ void Viewer::panel() {
                               "pssmlt: primary-sample-space Metropolis over the path tracer (docs/mlt.md)\n"
                               "mmlt: multiplexed Metropolis over BDPT's strategies, chains per path length");
         if (st.integrator.type == IntegratorType::Pssmlt || st.integrator.type == IntegratorType::Mmlt) {
-            // The chains as they run: acceptance of small and large steps, and the bootstrap's b.
+            // The chains as they run: acceptance of small and large steps, and b with its error.
             const MltStats ms = pssmlt_stats();
             if (ms.valid) {
                 auto rate = [](uint64_t a, uint64_t n) { return n ? 100.0 * double(a) / double(n) : 0.0; };
-                ImGui::Text("MLT: accept small %.1f%%, large %.1f%%, b %.4g", rate(ms.small_accepted, ms.small_proposed),
-                            rate(ms.large_accepted, ms.large_proposed), ms.b);
+                ImGui::Text("MLT: accept small %.1f%%, large %.1f%%", rate(ms.small_accepted, ms.small_proposed),
+                            rate(ms.large_accepted, ms.large_proposed));
+                ImGui::Text("b %.4g +- %.2g (%.2f%%)", ms.b, ms.b_std_error, ms.b > 0 ? 100.0 * ms.b_std_error / ms.b : 0.0);
                 if (ImGui::IsItemHovered())
-                    ImGui::SetTooltip("b: the bootstrap's mean luminance over the image (+- %.2g), the chains' normalisation.\n"
-                                      "%llu mutations over %d chains.",
-                                      ms.b_std_error, (unsigned long long)ms.mutations, st.integrator.mlt.chains);
+                    ImGui::SetTooltip("b: the image's mean luminance, which scales it: the bootstrap (%llu paths, %.2f s) pooled\n"
+                                      "with the %llu large steps so far.  %llu mutations over %zu chains.",
+                                      (unsigned long long)ms.bootstrap_paths, ms.bootstrap_seconds,
+                                      (unsigned long long)ms.large_steps, (unsigned long long)ms.mutations,
+                                      size_t(std::accumulate(ms.chains_per_depth.begin(), ms.chains_per_depth.end(), 0)));
             }
         }
         // What the integrator does not read is greyed out (integrator/caps.h): it cannot change,
