@@ -14,7 +14,8 @@
 // channel on the whole image. Each cell is tested at 0.01 Sidak-corrected over the scene's cells.
 // Control: the same renders 10% brighter must be rejected by the whole-image test at that level.
 //
-// pssmlt and mmlt also: the spread of the image mean (luminance, the shown image: mlt_output) over
+// pssmlt and mmlt (MatrixMlt: a tenth of the default bootstrap unless CANDELA_MATRIX_LONG=1) also:
+// the spread of the image mean (luminance, the shown image: mlt_output) over
 // the K seeds against the standard error of b they report (chi-square on K - 1 dof, both errors
 // large and small rejected; control: a third of the reported error is rejected).
 //
@@ -30,6 +31,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -59,6 +61,9 @@ struct MatrixScene {
     int width, height;
     // Why the particle tracer has no cell (nullptr: it has one).
     const char* no_ptracer;
+    // Multipliers of cell_spp where the noise is high (small lights; point lights for the particle
+    // tracer), so that the control is rejected.
+    int spp_scale = 1, ptracer_scale = 1;
 };
 
 constexpr const char* kEnvmap = "envmap: Mitsuba's ptracer is 2.2-2.5x its own path tracer";
@@ -66,14 +71,14 @@ constexpr const char* kEnvmap = "envmap: Mitsuba's ptracer is 2.2-2.5x its own p
 // The same table as tests/data/make_matrix_reference.py.
 const MatrixScene kScenes[] = {
     {"mdata_cbox_rgb_fragments", "cbox-rgb.xml", 24, 24, nullptr},
-    {"mdata_hello_teapot", "scenes/hello.xml", 32, 24, nullptr},
+    {"mdata_hello_teapot", "scenes/hello.xml", 32, 24, nullptr, 1, 4},
     {"mdata_matpreview", "matpreview.xml", 32, 24, kEnvmap},
     {"mdata_docs_bsdf_bumpmap_with", "docs/scenes/bsdf_bumpmap_with.xml", 32, 24, kEnvmap},
-    {"mdata_test_instancing", "tests/scenes/instancing/test_instancing_path.xml", 24, 24, nullptr},
+    {"mdata_test_instancing", "tests/scenes/instancing/test_instancing_path.xml", 24, 24, nullptr, 1, 4},
     {"mdata_test_orthographic", "test_orthographic_path.xml", 30, 18, "orthographic: a delta sensor no light path hits"},
     {"tutorials_cbox", "cbox.xml", 24, 24, nullptr},
     {"sionna_floor_wall", "floor_wall.xml", 32, 18, nullptr},
-    {"bitterli_veach_mis", "scene.xml", 32, 18, nullptr},
+    {"bitterli_veach_mis", "scene.xml", 32, 18, nullptr, 4, 1},
     {"blender_export_test1", "test1.xml", 32, 18, nullptr},
 };
 
@@ -132,7 +137,7 @@ struct CellResult {
     double seconds = 0;
 };
 
-CellResult run_cell(const MatrixScene& s, IntegratorType type) {
+CellResult run_cell(const MatrixScene& s, IntegratorType type, int mlt_bootstrap) {
     CellResult r;
     if (type == IntegratorType::Ptracer && s.no_ptracer) {
         r.skipped = s.no_ptracer;
@@ -153,9 +158,11 @@ CellResult run_cell(const MatrixScene& s, IntegratorType type) {
     desc.settings.height = s.height;
     desc.settings.integrator.type = type;
     desc.settings.integrator.aovs.clear();
+    if (mlt_bootstrap > 0) desc.settings.integrator.mlt.bootstrap_samples = mlt_bootstrap;
     const std::shared_ptr<const Scene> scene = build_scene(std::move(desc));
     const bool mlt = type == IntegratorType::Pssmlt || type == IntegratorType::Mmlt;
-    const int w = s.width, h = s.height, spp = cell_spp(type);
+    const int w = s.width, h = s.height,
+              spp = cell_spp(type) * s.spp_scale * (type == IntegratorType::Ptracer ? s.ptracer_scale : 1);
 
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<Means> runs;
@@ -256,12 +263,12 @@ CellResult run_cell(const MatrixScene& s, IntegratorType type) {
 }
 
 // The scene's row of the matrix for `types`, Sidak-corrected over all six integrators' cells.
-void matrix_row(const MatrixScene& s, const std::vector<IntegratorType>& types) {
+void matrix_row(const MatrixScene& s, const std::vector<IntegratorType>& types, int mlt_bootstrap = 0) {
     const double level = sidak_level(kAlpha, int(std::size(kIntegratorTypes)));
     std::printf("  %-30s %-8s %9s %9s %9s %9s %8s %9s %9s %6s\n", "scene", "integr.", "t whole", "p whole", "p blocks",
                 "p ctl10%", "rel", "p spread", "p spr/3", "s");
     for (IntegratorType t : types) {
-        const CellResult r = run_cell(s, t);
+        const CellResult r = run_cell(s, t, mlt_bootstrap);
         const char* name = integrator_type_name(t);
         if (!r.ran) {
             std::printf("  %-30s %-8s %s\n", s.folder, name, r.skipped.empty() ? "no reference" : r.skipped.c_str());
@@ -291,11 +298,16 @@ TEST_P(Matrix, EveryIntegratorAgreesWithTheReference) {
                {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Ptracer, IntegratorType::Bdpt});
 }
 
-// pssmlt and mmlt at their defaults (100000 bootstrap paths, per depth for mmlt, K times): the
-// long part (Release only: scripts/test.sh leaves it out of the Debug and sanitizer runs).
+// pssmlt and mmlt, every parameter at its default but the bootstrap: 10000 paths (per depth for
+// mmlt) instead of 100000, which at K seeds costs 8-75 s a scene (matpreview's 13 depths, loaded
+// 2-core machine); CANDELA_MATRIX_LONG=1 runs them at the defaults. b's larger error is what the
+// spread test checks against, and the large steps refine b as the render goes.
 class MatrixMlt : public ::testing::TestWithParam<int> {};
 TEST_P(MatrixMlt, AgreesWithTheReferenceAndItsError) {
-    matrix_row(kScenes[GetParam()], {IntegratorType::Pssmlt, IntegratorType::Mmlt});
+    const char* e = std::getenv("CANDELA_MATRIX_LONG");
+    const bool defaults = e && std::string(e) == "1";
+    std::printf("  bootstrap_samples %s\n", defaults ? "100000 (the default)" : "10000 (CANDELA_MATRIX_LONG=1: the default)");
+    matrix_row(kScenes[GetParam()], {IntegratorType::Pssmlt, IntegratorType::Mmlt}, defaults ? 0 : 10000);
 }
 
 std::string scene_name(const ::testing::TestParamInfo<int>& i) { return kScenes[i.param].folder; }

@@ -18,8 +18,10 @@ orthographic sensor: a delta sensor that no light path can hit) or is wrong (und
 map Mitsuba 3.9's ptracer is 2.2-2.5x its own path tracer).
 
 The committed references: mdata_cbox_rgb_fragments with --spp 1024 (path, direct; ptracer 4096),
-the other scenes with --spp 256 (ptracer 1024), 16 batches, llvm_ad_rgb, Mitsuba 3.9.1:
+bitterli_veach_mis with --spp 2048 (its small lights), the other scenes with --spp 256 (ptracer
+1024), 16 batches, llvm_ad_rgb, Mitsuba 3.9.1:
   $PY tests/data/make_matrix_reference.py --only mdata_cbox_rgb_fragments --spp 1024
+  $PY tests/data/make_matrix_reference.py --only bitterli_veach_mis --spp 2048
   $PY tests/data/make_matrix_reference.py --only SCENE --spp 256      (each other scene)
 """
 import argparse
