@@ -36,12 +36,13 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ASSETS = os.path.normpath(os.path.join(HERE, "..", "..", "assets", "scenes-public"))
 OUT = os.path.join(HERE, "matrix")
 
-# folder, main file, width, height, Mitsuba max_depth of the scene's integrator (-1 unbounded),
+# folder, main file, width, height, Mitsuba max_depth of the scene's integrator (-1 unbounded; hello.xml's
+# direct integrator: 2, which candela's --integrator keeps, render/launch.cpp),
 # the scene's own direct parameters (None: Mitsuba's defaults), ptracer possible.
 # tests/test_matrix.cpp has the same table.
 SCENES = [
     ("mdata_cbox_rgb_fragments", "cbox-rgb.xml", 24, 24, 6, None, True),
-    ("mdata_hello_teapot", "scenes/hello.xml", 32, 24, -1, {"emitter_samples": 4, "bsdf_samples": 0}, True),
+    ("mdata_hello_teapot", "scenes/hello.xml", 32, 24, 2, {"emitter_samples": 4, "bsdf_samples": 0}, True),
     ("mdata_matpreview", "matpreview.xml", 32, 24, -1, None, False),
     ("mdata_docs_bsdf_bumpmap_with", "docs/scenes/bsdf_bumpmap_with.xml", 32, 24, -1, None, False),
     ("mdata_test_instancing", "tests/scenes/instancing/test_instancing_path.xml", 24, 24, 2, None, True),
