@@ -17,8 +17,10 @@
 // pssmlt and mmlt (MatrixMlt: 40% of the default bootstrap unless CANDELA_MATRIX_LONG=1) also:
 // the spread of the image mean (luminance, the shown image: mlt_output) over
 // the K seeds against the standard error of b they report (chi-square on K - 1 dof, both errors
-// large and small rejected; control: a quarter of the reported error is rejected: with K = 8 a
-// third is not when the spread falls in chi-square's lower 7%, e.g. pssmlt on cbox-rgb).
+// large and small rejected; control: a fifth of the reported error is rejected. With K = 8 the
+// chi-square is wide: a control of a third fails when it falls below 2.5 (7% of the time), a
+// quarter below 1.4; pssmlt on cbox-rgb measured 1.5 (its seeds spread less than it reports), and a
+// fifth fails below 0.9 (0.3% of the time).
 //
 // The particle tracer is tested against Mitsuba's where both can see the scene (both miss the same
 // paths: those whose first camera-side vertex is specular, the emitters seen directly through
@@ -267,7 +269,7 @@ CellResult run_cell(const MatrixScene& s, IntegratorType type, int mlt_bootstrap
         // Two-sided: an error larger than reported (chi2 high) or much smaller (chi2 low).
         auto two_sided = [](double x) { return 2 * std::min(chi_square_sf(x, kK - 1), 1 - chi_square_sf(x, kK - 1)); };
         r.p_spread = two_sided(chi2);
-        r.p_spread_control = chi_square_sf(chi2 * 16, kK - 1);
+        r.p_spread_control = chi_square_sf(chi2 * 25, kK - 1);
     }
     r.ran = true;
     return r;
@@ -278,7 +280,7 @@ void matrix_row(const MatrixScene& s, const std::vector<IntegratorType>& types, 
     if (s.long_only && !long_form()) GTEST_SKIP() << s.folder << " runs with CANDELA_MATRIX_LONG=1 only: " << s.long_only;
     const double level = sidak_level(kAlpha, int(std::size(kIntegratorTypes)));
     std::printf("  %-30s %-8s %9s %9s %9s %9s %8s %9s %9s %6s\n", "scene", "integr.", "t whole", "p whole", "p blocks",
-                "p ctl10%", "rel", "p spread", "p spr/4", "s");
+                "p ctl10%", "rel", "p spread", "p spr/5", "s");
     for (IntegratorType t : types) {
         const CellResult r = run_cell(s, t, mlt_bootstrap);
         const char* name = integrator_type_name(t);
@@ -298,7 +300,7 @@ void matrix_row(const MatrixScene& s, const std::vector<IntegratorType>& types, 
         EXPECT_LT(r.p_control, level) << s.folder << " " << name << ": the 10% brighter control is not rejected";
         if (r.p_spread >= 0) {
             EXPECT_GE(r.p_spread, level) << s.folder << " " << name << ": image mean's spread over seeds against b's error";
-            EXPECT_LT(r.p_spread_control, level) << s.folder << " " << name << ": a quarter of b's error is not rejected";
+            EXPECT_LT(r.p_spread_control, level) << s.folder << " " << name << ": a fifth of b's error is not rejected";
         }
     }
 }
