@@ -13,7 +13,8 @@ matrix's size (the table below; the aspect ratio kept, so that the camera's fiel
 same); the scene's own filter, sampler and depth are kept. The integrator is built here with the
 scene's max_depth (the table's, read from the file), everything else at Mitsuba's defaults, except
 direct on the one scene whose own integrator is direct (hello.xml: its emitter_samples 4,
-bsdf_samples 0). The particle tracer has no reference where Mitsuba's cannot see the scene (the
+bsdf_samples 0; Mitsuba's direct counts its point light 4 times, so the test compares candela's
+direct with the path reference there, docs/lights.md). The particle tracer has no reference where Mitsuba's cannot see the scene (the
 orthographic sensor: a delta sensor that no light path can hit) or is wrong (under an environment
 map Mitsuba 3.9's ptracer is 2.2-2.5x its own path tracer).
 

@@ -10,8 +10,8 @@
 // light-sampling density (w_b = 1); light samples are taken only when the BSDF has a smooth part.
 // hide_emitters: the camera ray passes through area emitters (as in the path tracer) and does not
 // see the infinite lights. Delta lights (point, spot, directional) are reached by light samples
-// only, with w_l = 1 (Mitsuba's: not 1 / n_l, so they count n_l times); BSDF samples that leave the scene see the infinite lights, weighted as
-// above with each light's own density.
+// only, with w_l = 1 / n_l (Mitsuba's 1 counts them n_l times); BSDF samples that leave the scene
+// see the infinite lights, weighted as above with each light's own density.
 // Sample order per pixel sample: for each light sample next_1d (which emitter triangle), next_2d
 // (the point); then for each BSDF sample next_1d, next_2d.
 #include "integrator/integrator.h"
@@ -110,11 +110,10 @@ vec3 DirectIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
             ++stats.rays;
             const float T = shadow_transmittance(sc, shadow, masks, stats.rays);
             if (!(T > 0.f)) continue;
-            // A delta light: weight 1, exactly as Mitsuba 3.9's direct.cpp (`select(ds.delta, 1,
-            // mis_weight(...) * m_weight_lum)`): it is NOT divided by emitter_samples, so with n_l
-            // light samples a delta light counts n_l times. Kept for agreement with Mitsuba
-            // (docs/lights.md); the smooth lights get 1 / n_l.
-            const float w = ls.delta ? 1.f : mis_weight(ls.pdf * frac_light_, e.pdf * frac_bsdf_) * weight_light_;
+            // A delta light: no MIS (no BSDF sample can reach it), but still one of n_l samples, so
+            // 1 / n_l. Mitsuba 3.9's direct.cpp weights it 1 and so counts it n_l times: a bias of
+            // its own, not matched (docs/lights.md).
+            const float w = ls.delta ? weight_light_ : mis_weight(ls.pdf * frac_light_, e.pdf * frac_bsdf_) * weight_light_;
             L += f * ls.Le * (T * w / ls.pdf);
         }
     } else {
