@@ -266,6 +266,11 @@ ObjData read_obj(const std::string& path, bool materials) {
         uint32_t id = uint32_t(out.positions.size());
         const auto& v = attrib.vertices;
         size_t p = 3 * size_t(ix.vertex_index);
+        // tinyobjloader may read fewer vertices than the line check counted (a 'v' followed by a
+        // carriage return, found by fuzz_obj): an index it cannot resolve is an error, not a read.
+        if (ix.vertex_index < 0 || p + 2 >= v.size() ||
+            (ix.normal_index >= 0 && 3 * size_t(ix.normal_index) + 2 >= attrib.normals.size()))
+            throw Error(path, 0, "a face refers to a vertex or normal that the file does not define");
         out.positions.push_back(vec3(float(v[p]), float(v[p + 1]), float(v[p + 2])));
         vec3 nrm(0.f);
         bool has = ix.normal_index >= 0;
