@@ -210,6 +210,35 @@ TEST(Denoise, MissingLibraryWritesRawImage) {
     EXPECT_TRUE(x.count("albedo.R") && !x.count("noisy.R"));
 }
 
+// A failure inside the library (support/fake_oidn.cpp: every call succeeds until a filter runs,
+// which fails with out of memory, as OIDN reports it): one line naming the library's own message,
+// the raw image written in place of the denoised one with the auxiliaries as its layers, exit 1.
+TEST(Denoise, FailureInsideTheLibraryWritesRawImage) {
+    REQUIRE_OIDN();
+    const std::string d = test::temp_dir("denoise-fails");
+    const std::string common = "--width 16 --height 16 --frames 2 --quiet ";
+    auto raw = test::run_candela(common + "--out " + d + "/raw.exr");
+    ASSERT_EQ(raw.exit_code, 0) << raw.output;
+    for (const char* out : {"x.exr", "x.png"}) {
+        auto r = test::run_candela(common + "--denoise --out " + d + "/" + out,
+                                   std::string("CANDELA_OIDN_LIBRARY=") + test_paths::fake_oidn());
+        EXPECT_EQ(r.exit_code, 1) << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+        EXPECT_NE(r.output.find("Open Image Denoise failed to denoise: out of memory (fake library for tests)"),
+                  std::string::npos)
+            << r.output;
+        EXPECT_NE(r.output.find("the raw image is written instead"), std::string::npos) << r.output;
+    }
+    auto x = read_exr_channels(d + "/x.exr");
+    auto ref = read_exr_channels(d + "/raw.exr");
+    EXPECT_EQ(x["R"], ref["R"]);
+    EXPECT_EQ(x["B"], ref["B"]);
+    EXPECT_TRUE(x.count("albedo.R") && x.count("normal.X") && !x.count("noisy.R"));
+    // Beside the PNG: the raw beauty's layers file, as when the denoise succeeds.
+    auto layers = read_exr_channels(d + "/x.layers.exr");
+    EXPECT_TRUE(layers.count("albedo.R")) << "no layers beside the PNG";
+}
+
 // The viewer's session: turned on, the denoised image follows the full passes on its own thread,
 // with the film's generation; the raw images go on being published as before.
 TEST(Denoise, SessionDenoisesInBackground) {

@@ -12,4 +12,11 @@ const char* mpirun() {
     return "mpiexec";
 #endif
 }
+const char* fake_oidn() {
+#ifdef CANDELA_PATH_FAKE_OIDN
+    return CANDELA_PATH_FAKE_OIDN;
+#else
+    return "";
+#endif
+}
 }  // namespace candela::test_paths

@@ -11,6 +11,7 @@ const char* source_dir();   // the repository root
 const char* test_data();    // tests/data
 const char* assets_dir();   // assets/: the scanned meshes and public scenes (assets/SOURCES.md)
 const char* mpirun();       // mpiexec, in a build with MPI
+const char* fake_oidn();    // support/fake_oidn.cpp's library, in a build with CANDELA_OIDN ("" without)
 // A file under assets/ ("meshes/bunny.obj", "scenes-public/..."). The assets are part of the
 // repository: a test that cannot open one fails, it never skips.
 inline std::string asset(const std::string& relative) { return std::string(assets_dir()) + "/" + relative; }
