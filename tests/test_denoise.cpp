@@ -41,9 +41,9 @@ double rel_mse(const std::vector<float>& x, const std::vector<float>& ref) {
     return s / double(x.size());
 }
 
-std::vector<float> cornell_reference(int* w) {
+std::vector<float> cornell_reference(int* w, const char* file = "cornell64_mean.exr") {
     int h = 0;
-    auto ch = read_exr_channels(std::string(CANDELA_TEST_DATA) + "/cornell64_mean.exr", w, &h);
+    auto ch = read_exr_channels(std::string(CANDELA_TEST_DATA) + "/" + file, w, &h);
     std::vector<float> rgb(size_t(*w) * size_t(h) * 3);
     for (size_t i = 0; i < size_t(*w) * size_t(h); ++i) {
         rgb[3 * i] = ch["R"][i];
@@ -154,6 +154,31 @@ TEST(Denoise, CornellDenoised16BeatsRaw32) {
     std::printf("  relMSE: raw 16 spp %.5f, raw 32 spp %.5f, denoised 16 spp %.5f\n", e_raw16, e_raw32, e_dn16);
     EXPECT_LT(e_dn16, e_raw32);
     EXPECT_GT(e_raw16, e_raw32);  // control
+}
+
+// The issue's bar: the denoised Cornell box at 16 spp is closer to the reference than the raw one at
+// 256 spp. At 256 x 256 (at 128 x 128 it is not: 0.00119 against 0.00081, docs/denoising.md; OIDN
+// sees too few pixels per feature there). The reference (cornell256_ref.exr, 1024 spp, another
+// seed, made by `candela --width 256 --height 256 --frames 1024 --seed 777 --out tests/data/cornell256_ref.exr`) adds its own variance to both errors alike, so
+// it does not favour either side.
+TEST(Denoise, CornellDenoised16BeatsRaw256) {
+    REQUIRE_OIDN();
+    int w = 0;
+    const std::vector<float> ref = cornell_reference(&w, "cornell256_ref.exr");
+    ASSERT_EQ(w, 256);
+    SceneOverrides ov;
+    ov.width = ov.height = 256;
+    ov.denoise_aux = true;
+    auto scene = prepare_scene("", ov);
+    auto f16 = render(*scene, 16);
+    auto f256 = render(*scene, 256);
+    Denoiser dn(DenoiseQuality::High);
+    std::vector<float> out;
+    dn.denoise(denoise_inputs(*f16, scene->settings.integrator.aovs), out);
+    const double e_dn16 = rel_mse(out, ref), e_raw16 = rel_mse(f16->resolve(), ref), e_raw256 = rel_mse(f256->resolve(), ref);
+    std::printf("  relMSE: raw 16 spp %.6f, raw 256 spp %.6f, denoised 16 spp %.6f\n", e_raw16, e_raw256, e_dn16);
+    EXPECT_LT(e_dn16, e_raw256);
+    EXPECT_GT(e_raw16, 8 * e_raw256);  // control: the raw error falls as 1/spp (16x the samples)
 }
 
 // --denoise on the command line: R, G, B denoised, the raw beauty as "noisy" (bit for bit the
