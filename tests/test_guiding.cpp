@@ -2,7 +2,8 @@
 // with a control that must fail), that density integrates to 1 over the sphere, training on a known
 // incident light learns it (KL divergence, against a control that records the wrong value), the
 // spatial tree splits where the splats are as c sqrt(2^k) says, the node budget holds, and the
-// merged tree is the same bit for bit for any thread count.
+// merged tree is the same bit for bit for any thread count, and the learned BSDF fraction moves
+// towards the strategy that matches the integrand.
 #include <gtest/gtest.h>
 #include <cmath>
 #include "core/frame.h"
@@ -360,4 +361,40 @@ TEST(Guiding, TrainingPlanDoubles) {
             EXPECT_GE(p.back().spp, 2 * p[p.size() - 2].spp);
         }
     }
+}
+
+// The learned BSDF fraction moves towards the strategy that matches the integrand: towards the
+// guide when the integrand is the lobe the guide learned (the "BSDF" uniform), towards the BSDF
+// when the integrand is the BSDF's own cosine (the guide learned an unrelated lobe). The two
+// cases are each other's control: the same learner must end on opposite sides of 1/2.
+TEST(Guiding, LearnedFractionFindsTheBetterStrategy) {
+    const Lobe lobe;
+    const Quadtree guide = train_on_lobe(lobe, 5, 20);
+    auto learn = [&](bool integrand_is_lobe) {
+        FractionLearner learner;
+        PCG32 rng(12, 3);
+        for (int i = 0; i < 20000; ++i) {
+            const GuideMixture mix = learner.mixture();
+            float u = rng.next_float();
+            const vec2 u2 = next_2d(rng);
+            vec3 d;
+            float bsdf_pdf;
+            if (integrand_is_lobe) {
+                d = mix.use_bsdf(u) ? square_to_uniform_sphere(u2) : guide.sample(u2, nullptr);
+                bsdf_pdf = kInv4Pi;
+            } else {
+                d = mix.use_bsdf(u) ? square_to_cosine_hemisphere(u2) : guide.sample(u2, nullptr);
+                bsdf_pdf = square_to_cosine_hemisphere_pdf(d);
+            }
+            const float guide_pdf = guide.pdf(d);
+            const float f = integrand_is_lobe ? lobe.radiance(d) : std::max(d.z, 0.f) * kInvPi;
+            learner.step(f, bsdf_pdf, guide_pdf, mix.pdf(bsdf_pdf, guide_pdf));
+        }
+        return learner.fraction();
+    };
+    const float towards_guide = learn(true), towards_bsdf = learn(false);
+    std::printf("learned BSDF fraction: %.3f (integrand = the guide's lobe), %.3f (integrand = the cosine)\n",
+                towards_guide, towards_bsdf);
+    EXPECT_LT(towards_guide, 0.3f);
+    EXPECT_GT(towards_bsdf, 0.7f);
 }
