@@ -46,6 +46,14 @@ inline vec3 square_to_uniform_sphere(vec2 u) {
     return vec3(r * std::cos(phi), r * std::sin(phi), z);
 }
 inline float square_to_uniform_sphere_pdf(vec3) { return kInv4Pi; }
+// The inverse of square_to_uniform_sphere (cylindrical, equal-area: u = ((1 - z) / 2, phi / 2pi)),
+// clamped into [0,1)^2 so that a cell lookup never falls off the square.
+inline vec2 uniform_sphere_to_square(vec3 d) {
+    float phi = std::atan2(d.y, d.x);
+    if (phi < 0.f) phi += 2.f * kPi;
+    const float one_below = 0x1.fffffep-1f;
+    return vec2(std::clamp(0.5f * (1.f - d.z), 0.f, one_below), std::clamp(phi * kInv2Pi, 0.f, one_below));
+}
 
 // Uniform direction in the cone of half-angle acos(cos_max) about +z; pdf = 1 / (2 pi (1 - cos_max))
 // per steradian inside the cone, 0 outside.
