@@ -103,6 +103,7 @@ const MatrixScene kScenes[] = {
 int cell_spp(IntegratorType t) {
     switch (t) {
         case IntegratorType::Path: return 32;
+        case IntegratorType::Volpath: return 32;
         case IntegratorType::Direct: return 32;
         case IntegratorType::Ptracer: return 32;
         case IntegratorType::Bdpt: return 16;
