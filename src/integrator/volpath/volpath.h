@@ -35,8 +35,11 @@ public:
     // Transmittance from `o` along `shadow` (from spawn_ray_to or spawn_ray, which set tmax)
     // starting in `medium`: the product over segments of exp(-sigma_t length) and over crossed
     // surfaces of 1 - opacity (0 at any surface that is not null or masked). `surface_T` gets the
-    // product of the surfaces' factors alone (the MIS weight's, as the path tracer's).
-    vec3 shadow_transmittance(Ray shadow, int32_t medium, float& surface_T, uint64_t& rays) const;
+    // product of the surfaces' factors alone (the MIS weight's, as the path tracer's). In a
+    // heterogeneous medium a segment's factor is ratio tracking's estimate (random numbers from
+    // `sampler`; a homogeneous one draws none).
+    template <class S>
+    vec3 shadow_transmittance(Ray shadow, int32_t medium, float& surface_T, S& sampler, uint64_t& rays) const;
 
 private:
     const Scene& scene_;
@@ -59,8 +62,9 @@ inline int32_t medium_after(const Shape& s, vec3 ng, vec3 w, int32_t current) {
     return glm::dot(w, ng) > 0.f ? s.exterior : s.interior;
 }
 
-inline vec3 VolpathIntegrator::shadow_transmittance(Ray shadow, int32_t medium, float& surface_T,
-                                                    uint64_t& rays) const {
+template <class S>
+vec3 VolpathIntegrator::shadow_transmittance(Ray shadow, int32_t medium, float& surface_T, S& sampler,
+                                             uint64_t& rays) const {
     const Scene& sc = scene_;
     const bool to_point = std::isfinite(shadow.tmax);
     const vec3 target = shadow.o + shadow.d;
@@ -70,8 +74,16 @@ inline vec3 VolpathIntegrator::shadow_transmittance(Ray shadow, int32_t medium, 
         Hit h;
         const bool found = sc.accel->intersect(shadow, h);  // shrinks tmax to the hit
         if (medium >= 0) {
-            const float len = std::isfinite(shadow.tmax) ? shadow.tmax * glm::length(shadow.d) : kInfinity;
-            T *= transmittance(media_[size_t(medium)], len);
+            const float dl = glm::length(shadow.d);
+            const float len = std::isfinite(shadow.tmax) ? shadow.tmax * dl : kInfinity;
+            const Medium& m = media_[size_t(medium)];
+            if (m.heterogeneous()) {
+                Ray unit = shadow;
+                unit.d = shadow.d / dl;
+                T *= ratio_track(m, unit, len, sampler);
+            } else {
+                T *= transmittance(m, len);
+            }
             if (is_black(T)) return vec3(0.f);
         }
         if (!found) return T;
@@ -133,11 +145,25 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         if (medium >= 0) {
             const Medium& m = media_[size_t(medium)];
             const float t_surface = found ? hit.t : kInfinity;
-            const float t = sample_distance(m, channel, sampler.next_1d());
-            if (t < t_surface) {
-                // A scattering event in the medium.
-                const vec3 tr = transmittance(m, t);
-                beta *= m.sigma_s() * tr / (m.sigma_t[channel] * tr[channel]);
+            // A scattering event before the surface, and its weight (the estimator in the header).
+            float t = kInfinity;
+            bool scatter;
+            if (m.heterogeneous()) {
+                // Delta tracking (grey extinction): a real collision's weight is the albedo there.
+                scatter = delta_track(m, ray, t_surface, sampler, t);
+                if (scatter) beta *= albedo_at(m, ray.o + t * ray.d);
+            } else {
+                t = sample_distance(m, channel, sampler.next_1d());
+                scatter = t < t_surface;
+                const vec3 tr = transmittance(m, scatter ? t : t_surface);
+                if (scatter) {
+                    beta *= m.sigma_s() * tr / (m.sigma_t[channel] * tr[channel]);
+                } else {
+                    if (!(tr[channel] > 0.f)) break;
+                    beta *= tr / tr[channel];
+                }
+            }
+            if (scatter) {
                 ++depth;
                 valid = true;
                 if (st.max_depth >= 0 && depth > st.max_depth) break;
@@ -158,7 +184,7 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                         }
                         ++stats.rays;
                         float surface_T = 1.f;
-                        const vec3 T = shadow_transmittance(shadow, medium, surface_T, stats.rays);
+                        const vec3 T = shadow_transmittance(shadow, medium, surface_T, sampler, stats.rays);
                         if (!is_black(T)) {
                             const float w =
                                 mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, ph * surface_T) : 1.f;
@@ -175,10 +201,6 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                 ray.d = glm::normalize(wo);
                 continue;
             }
-            // The surface (or nothing) comes first.
-            const vec3 tr = transmittance(m, t_surface);
-            if (!(tr[channel] > 0.f)) break;
-            beta *= tr / tr[channel];
         }
 
         if (!found) {
@@ -220,7 +242,7 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                     ++stats.rays;
                     float surface_T = 1.f;
                     const vec3 T = shadow_transmittance(shadow_ray(si, ls), medium_after(shape, ng, ls.wi, medium),
-                                                        surface_T, stats.rays);
+                                                        surface_T, sampler, stats.rays);
                     if (!is_black(T)) {
                         const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * surface_T) : 1.f;
                         L += beta * e.f * ls.Le * T * (w / ls.pdf);

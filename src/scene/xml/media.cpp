@@ -1,6 +1,7 @@
 // The medium family of the XML reader: Mitsuba 3's `homogeneous` medium (src/media/homogeneous.cpp)
 // with its phase functions `isotropic` and `hg` (src/phase/), and the media that shapes and the
 // sensor name. docs/media.md lists what is read and what is refused.
+#include <glm/gtc/matrix_transform.hpp>
 #include "scene/xml/plugins.h"
 
 namespace candela {
@@ -8,21 +9,62 @@ namespace xml {
 
 namespace {
 
-// A medium parameter given as a value (float, rgb, spectrum) or as a nested constvolume.
-vec3 medium_value(XmlLoader& L, Object& o, const std::string& name, vec3 def) {
+// A medium parameter: a value (float, rgb, spectrum), a nested constvolume, or (heterogeneous media
+// only) a nested gridvolume with its world-to-grid transform.
+struct MediumValue {
+    vec3 value{0.f};
+    std::shared_ptr<const VolumeGrid> grid;
+    glm::mat4 to_local{1.f};
+};
+
+MediumValue medium_value(XmlLoader& L, Object& o, const std::string& name, vec3 def, bool grids) {
+    MediumValue out;
     for (Nested& c : o.nested) {
         if (c.tag != "volume" || L.attr(c.node, "name") != name) continue;
         if (o.params.has(name)) throw L.error(c.node, o.what() + ": '" + name + "' given twice");
         Object v = L.read_object(c.node, "volume");
-        if (v.type != "constvolume")
-            throw L.error(c.node, "unsupported volume type '" + v.type + "' (candela supports: constvolume)");
-        const vec3 value = v.params.get_rgb("value", vec3(1.f));
-        v.params.get_transform("to_world", mat4(1.f));  // a constant has no place
+        const glm::mat4 to_world = v.params.get_transform("to_world", glm::mat4(1.f));
+        if (v.type == "constvolume") {
+            out.value = v.params.get_rgb("value", vec3(1.f));
+        } else if (v.type == "gridvolume" && grids) {
+            const std::string file = v.params.get_string("filename", "");
+            if (file.empty()) throw L.error(c.node, "gridvolume needs a 'filename'");
+            const std::string filter = v.params.get_string("filter_type", "trilinear");
+            if (filter != "trilinear" && filter != "nearest")
+                throw v.params.error("filter_type", "filter_type must be trilinear or nearest");
+            const std::string wrap = v.params.get_string("wrap_mode", "clamp");
+            if (wrap != "clamp") throw v.params.error("wrap_mode", "candela reads wrap_mode clamp only");
+            const bool grid_bbox = v.params.get_bool("use_grid_bbox", false);
+            v.params.get_bool("raw", false);    // sRGB to spectrum in Mitsuba's spectral modes: none in RGB
+            v.params.get_bool("accel", true);   // Mitsuba's texture storage
+            VolumeGrid g;
+            try {
+                g = read_vol(L.resolve(c.node, file));
+            } catch (const Error& e) {
+                throw Error(std::string(e.what()) + " (gridvolume at " + L.file_of(c.node) + ":" +
+                            std::to_string(L.line(c.node)) + ")");
+            }
+            g.nearest = filter == "nearest";
+            glm::mat4 m = to_world;
+            if (grid_bbox) {  // the unit cube onto the file's box, then to_world
+                const vec3 e = g.bbox.extent();
+                if (!(e.x > 0.f && e.y > 0.f && e.z > 0.f) || !all_finite(e))
+                    throw L.error(c.node, "use_grid_bbox: the .vol file's bounding box is empty");
+                m = m * glm::translate(glm::mat4(1.f), g.bbox.min) * glm::scale(glm::mat4(1.f), e);
+            }
+            if (!(std::abs(glm::determinant(glm::mat3(m))) > 0.f)) throw L.error(c.node, "gridvolume's to_world is singular");
+            out.to_local = glm::inverse(m);
+            out.grid = std::make_shared<const VolumeGrid>(std::move(g));
+        } else {
+            throw L.error(c.node, "unsupported volume type '" + v.type + "' for " + o.what() + " (candela supports: " +
+                                      (grids ? "constvolume, gridvolume" : "constvolume") + ")");
+        }
         L.finish(v);
         c.used = true;
-        return value;
+        return out;
     }
-    return o.params.get_rgb(name, def);
+    out.value = o.params.get_rgb(name, def);
+    return out;
 }
 
 float phase_g(XmlLoader& L, Object& medium) {
@@ -51,15 +93,36 @@ int32_t load_medium(XmlLoader& L, pugi::xml_node n) {
     auto it = L.media.find(n.internal_object());
     if (it != L.media.end()) return it->second;
     Object o = L.read_object(n, "medium");
-    if (o.type != "homogeneous")
-        throw L.error(n, "unsupported medium type '" + o.type + "' (candela supports: homogeneous)");
+    const bool heterogeneous = o.type == "heterogeneous";
+    if (o.type != "homogeneous" && !heterogeneous)
+        throw L.error(n, "unsupported medium type '" + o.type + "' (candela supports: homogeneous, heterogeneous)");
     Medium m;
     m.name = n.attribute("id") ? L.attr(n, "id") : std::string("medium");
-    const vec3 sigma_t = medium_value(L, o, "sigma_t", vec3(1.f));
-    m.albedo = medium_value(L, o, "albedo", vec3(0.75f));
+    const MediumValue st = medium_value(L, o, "sigma_t", vec3(1.f), heterogeneous);
+    const MediumValue al = medium_value(L, o, "albedo", vec3(0.75f), heterogeneous);
+    const vec3 sigma_t = st.value;
+    m.albedo = al.value;
     const float scale = o.params.get_float("scale", 1.f);
     if (!(scale >= 0.f) || !std::isfinite(scale)) throw o.params.error("scale", "scale must be finite and >= 0");
     m.sigma_t = sigma_t * scale;
+    if (heterogeneous) {
+        if (!st.grid) throw L.error(n, o.what() + ": candela reads a heterogeneous medium's sigma_t from a gridvolume");
+        if (st.grid->channels != 1)
+            throw L.error(n, o.what() + ": a sigma_t grid of 3 channels (colour extinction) is not supported: use one channel");
+        for (float v : st.grid->data)
+            if (v < 0.f) throw L.error(n, o.what() + ": the sigma_t grid has a negative density (a negative density has no meaning)");
+        m.density = st.grid;
+        m.density_to_local = st.to_local;
+        m.albedo_grid = al.grid;
+        m.albedo_to_local = al.to_local;
+        if (al.grid)
+            for (float v : al.grid->data)
+                if (!(v >= 0.f && v <= 1.f)) throw L.error(n, o.what() + ": the albedo grid has values outside [0, 1]");
+        m.scale = scale;
+        m.majorant = scale * st.grid->max_value;
+        m.sigma_t = vec3(m.majorant);  // checked below like a homogeneous medium's
+        m.albedo = al.grid ? vec3(0.5f) : m.albedo;
+    }
     for (int c = 0; c < 3; ++c) {
         if (!(sigma_t[c] >= 0.f) || !std::isfinite(m.sigma_t[c]))
             throw L.error(n, o.what() + ": sigma_t must be finite and >= 0 (a negative density has no meaning)");
