@@ -5,11 +5,13 @@
 // against Mitsuba 3 (tests/data/scenes/media_spheres.xml), each with a control that must fail.
 #include <gtest/gtest.h>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include "core/error.h"
 #include "integrator/caps.h"
 #include "integrator/volpath/volpath.h"
 #include "render/launch.h"
+#include "render/renderer.h"
 #include "scene/loaders.h"
 #include "support/load_error.h"
 #include "support/render.h"
@@ -426,4 +428,26 @@ TEST(Volpath, MatchesMitsubaOnAHeterogeneousMedium) {
     const double pc = whole_image_p(dark, ref, &rel);
     std::printf("  control, albedo -5%%: whole image p = %.3g, rel (%.4f %.4f %.4f)\n", pc, rel.x, rel.y, rel.z);
     EXPECT_LT(pc, kAlpha);
+}
+
+// Same scene, seed and spp: the same image bit for bit on 1 and 2 threads (both media kinds), and
+// no non-finite value reaches the film.
+TEST(Volpath, ThreadCountDoesNotChangeTheImage) {
+    for (const char* name : {"media_spheres.xml", "media_hetero.xml"}) {
+        auto sc = build_scene(load_scene(std::string(CANDELA_TEST_DATA) + "/scenes/" + name, {{"res", "24"}}));
+        Film a(24, 24), b(24, 24);
+        configure_film(a, sc->settings);
+        configure_film(b, sc->settings);
+        Renderer::render_pass(*sc, a, 0, 4, 1);
+        Renderer::render_pass(*sc, b, 0, 4, 2);
+        double sum = 0;
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                const vec3 pa = a.pixel(x, y), pb = b.pixel(x, y);
+                ASSERT_EQ(std::memcmp(&pa, &pb, sizeof pa), 0) << name << " pixel " << x << ", " << y;
+                ASSERT_TRUE(all_finite(pa)) << name;
+                sum += pa.x + pa.y + pa.z;
+            }
+        EXPECT_GT(sum, 1.0) << name;
+    }
 }
