@@ -3,14 +3,14 @@
 # ctest. Builds tests/fuzz/ into build-fuzz/, then runs each target for SECONDS (default 300) on a
 # working corpus in build-fuzz/corpus/<target> seeded from tests/fuzz/corpus/. Crashing inputs land
 # in build-fuzz/artifacts/<target>/; the script prints them and exits 1 if there are any.
-# Usage: bash scripts/fuzz.sh [SECONDS] [TARGET...]      (targets: fuzz_xml fuzz_obj fuzz_ply fuzz_serialized fuzz_image fuzz_curve)
+# Usage: bash scripts/fuzz.sh [SECONDS] [TARGET...]      (targets: fuzz_xml fuzz_obj fuzz_ply fuzz_serialized fuzz_image fuzz_curve fuzz_vol)
 # Replay one input: build-fuzz/fuzz_xml FILE
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 secs=${1:-300}
 shift || true
 targets=("$@")
-[ "${#targets[@]}" -eq 0 ] && targets=(fuzz_xml fuzz_obj fuzz_ply fuzz_serialized fuzz_image fuzz_curve)
+[ "${#targets[@]}" -eq 0 ] && targets=(fuzz_xml fuzz_obj fuzz_ply fuzz_serialized fuzz_image fuzz_curve fuzz_vol)
 bash scripts/setup.sh --with-fuzz
 
 if [ ! -f build-fuzz/build.ninja ]; then

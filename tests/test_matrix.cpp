@@ -103,6 +103,7 @@ const MatrixScene kScenes[] = {
 int cell_spp(IntegratorType t) {
     switch (t) {
         case IntegratorType::Path: return 32;
+        case IntegratorType::Volpath: return 32;
         case IntegratorType::Direct: return 32;
         case IntegratorType::Ptracer: return 32;
         case IntegratorType::Bdpt: return 16;
@@ -280,9 +281,10 @@ CellResult run_cell(const MatrixScene& s, IntegratorType type, int mlt_bootstrap
     return r;
 }
 
-// The scene's row of the matrix for `types`, Sidak-corrected over all six integrators' cells.
+// The scene's row of the matrix for `types`, Sidak-corrected over all six integrators' cells
+// (volpath has none: on these scenes, which have no media, it is the path tracer).
 void matrix_row(const MatrixScene& s, const std::vector<IntegratorType>& types, int mlt_bootstrap = 0) {
-    const double level = sidak_level(kAlpha, int(std::size(kIntegratorTypes)));
+    const double level = sidak_level(kAlpha, int(std::size(kIntegratorTypes)) - 1);
     std::printf("  %-30s %-8s %9s %9s %9s %9s %8s %9s %9s %6s\n", "scene", "integr.", "t whole", "p whole", "p blocks",
                 "p ctl10%", "rel", "p spread", "p spr/5", "s");
     for (IntegratorType t : types) {

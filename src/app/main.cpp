@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
                                  "Metropolis over the path tracer) or mmlt (multiplexed Metropolis over BDPT; for both\n"
                                  "the sample count is mutations per pixel, docs/mlt.md);\n"
                                  "replaces the scene's <integrator> type, keeping its depths and hide_emitters")
-                      ->check(CLI::IsMember({"path", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
+                      ->check(CLI::IsMember({"path", "volpath", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
     auto* m_opt = app.add_option("--sampling", sampling,
                                  "The path tracer's emission sampling (path, pssmlt): light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,

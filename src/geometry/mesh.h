@@ -91,6 +91,11 @@ struct Shape {
     // Index into Geometry::groups for a shape of a shapegroup: first_triangle and analytic then
     // index the group's mesh and shapes, and the shape is only seen through instances.
     int32_t group = -1;
+    // Participating media on either side (medium/medium.h): indices into Geometry::media, -1 for
+    // none. A ray that crosses a shape naming either takes the one on the side it leaves towards
+    // (exterior: the side the geometric normal points to); other shapes leave its medium as is.
+    int32_t interior = -1, exterior = -1;
+    bool medium_transition() const { return interior >= 0 || exterior >= 0; }
 };
 
 }  // namespace candela

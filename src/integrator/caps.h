@@ -30,13 +30,15 @@ struct IntegratorCaps {
     bool aovs;        // the aov and moment wrappers (values of the camera ray's first hit)
     bool checkpoint;  // --checkpoint, --resume
     bool time_limit;  // --time-limit cuts the pass in flight
-    bool media;       // participating media (none is read yet)
+    bool media;       // participating media (medium/medium.h); the others refuse a scene with media
     bool guiding;     // path guiding (none yet)
 };
 
 // clang-format off
 //                                     sampling sampler filter max_d  rr_d   hide   mpi    adapt  aovs   ckpt   time   media  guide
 inline constexpr IntegratorCaps kPathCaps    {true,   true,   true,  true,  true,  true,  true,  true,  true,  true,  true,  false, false};
+// volpath: the path tracer's settings and features (it is the path tracer in a scene without media).
+inline constexpr IntegratorCaps kVolpathCaps {true,   true,   true,  true,  true,  true,  true,  true,  true,  true,  true,  true,  false};
 // direct: emitter_samples and bsdf_samples instead of the sampling mode; one scattering event.
 inline constexpr IntegratorCaps kDirectCaps  {false,  true,   true,  false, false, true,  true,  true,  true,  true,  true,  false, false};
 // ptracer: splats land in the pixel they project to (a box) whatever the film's filter.
@@ -58,13 +60,14 @@ constexpr const IntegratorCaps& reads(IntegratorType t) {
         case IntegratorType::Bdpt: return kBdptCaps;
         case IntegratorType::Pssmlt: return kPssmltCaps;
         case IntegratorType::Mmlt: return kMmltCaps;
+        case IntegratorType::Volpath: return kVolpathCaps;
         case IntegratorType::Path: break;
     }
     return kPathCaps;
 }
 
 // Every integrator, in the command line's order, and its name there (path, direct, ...).
-inline constexpr IntegratorType kIntegratorTypes[] = {IntegratorType::Path, IntegratorType::Direct,
+inline constexpr IntegratorType kIntegratorTypes[] = {IntegratorType::Path, IntegratorType::Volpath, IntegratorType::Direct,
                                                       IntegratorType::Ptracer, IntegratorType::Bdpt,
                                                       IntegratorType::Pssmlt, IntegratorType::Mmlt};
 

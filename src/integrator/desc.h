@@ -8,7 +8,8 @@
 namespace candela {
 
 enum class IntegratorType {
-    Path,    // path (and volpath in a scene without media): integrator/path/
+    Path,    // path: integrator/path/
+    Volpath, // volpath, volpathmis: integrator/volpath/ (the path tracer in a scene without media)
     Direct,  // direct: integrator/direct/
     Ptracer, // ptracer (light tracing, splats only): integrator/ptracer/
     Bdpt,    // bdpt (bidirectional path tracing, camera samples and splats): integrator/bdpt/

@@ -4,6 +4,7 @@
 #include "integrator/mlt/pssmlt.h"
 #include "integrator/path/path_pass.h"
 #include "integrator/ptracer/ptracer.h"
+#include "integrator/volpath/volpath.h"
 
 namespace candela {
 
@@ -14,6 +15,10 @@ std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
         case IntegratorType::Bdpt: return std::make_unique<BdptPass>();
         case IntegratorType::Pssmlt: return std::make_unique<PssmltPass>();
         case IntegratorType::Mmlt: return std::make_unique<MmltPass>();
+        // Without media volpath is the path tracer (the same image bit for bit, and its speed).
+        case IntegratorType::Volpath:
+            if (!scene.geometry->media.empty()) return std::make_unique<VolpathPass>();
+            break;
         case IntegratorType::Path: break;
     }
     return std::make_unique<PathPass>();

@@ -74,6 +74,10 @@ void check_reads(SceneDescription& desc, const SceneOverrides& ov) {
         if (ov.integrator && st.rr_depth != 5) note("the scene's rr_depth " + std::to_string(st.rr_depth));
     }
     if (!c.hide_emitters && st.integrator.hide_emitters) note("the scene's hide_emitters");
+    if (!c.media && !desc.media.empty()) {
+        if (ov.integrator) refuse("--integrator", "the scene has participating media: use volpath");
+        throw Error(desc.source, desc.media_line, "the " + name + " integrator does not render participating media; use volpath");
+    }
 }
 
 }  // namespace
@@ -121,7 +125,8 @@ IntegratorType parse_integrator_type(const std::string& s) {
     if (s == "bdpt") return IntegratorType::Bdpt;
     if (s == "pssmlt") return IntegratorType::Pssmlt;
     if (s == "mmlt") return IntegratorType::Mmlt;
-    throw Error("unknown integrator '" + s + "' (expected path, direct, ptracer, bdpt, pssmlt or mmlt)");
+    if (s == "volpath") return IntegratorType::Volpath;
+    throw Error("unknown integrator '" + s + "' (expected path, volpath, direct, ptracer, bdpt, pssmlt or mmlt)");
 }
 
 const char* integrator_type_name(IntegratorType t) {
@@ -131,6 +136,7 @@ const char* integrator_type_name(IntegratorType t) {
         case IntegratorType::Bdpt: return "bdpt";
         case IntegratorType::Pssmlt: return "pssmlt";
         case IntegratorType::Mmlt: return "mmlt";
+        case IntegratorType::Volpath: return "volpath";
         default: return "path";
     }
 }

@@ -3,6 +3,8 @@
 #include "accel/instances.h"
 #include "accel/with_analytic.h"
 #include "film/film.h"
+#include "integrator/caps.h"
+#include "render/launch.h"  // integrator_type_name
 
 namespace candela {
 
@@ -157,6 +159,27 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       light_params(p.lights),
       warnings(std::move(warnings_)) {}
 
+namespace {
+
+// Media indices in range and valid values; and an integrator that renders media (integrator/caps.h)
+// when there are any: the others refuse the scene rather than render it without them.
+void check_media(const std::string& source, int line, const std::vector<Medium>& media, int32_t camera_medium,
+                 const std::vector<Shape>& shapes, const RenderSettings& st) {
+    auto in_range = [&](int32_t i) { return i >= -1 && i < int32_t(media.size()); };
+    if (!in_range(camera_medium)) throw Error(source, 0, "camera medium index out of range");
+    for (const Shape& s : shapes)
+        if (!in_range(s.interior) || !in_range(s.exterior))
+            throw Error(source, 0, "shape '" + s.name + "': medium index out of range");
+    for (const Medium& m : media)
+        if (const char* e = medium_error(m)) throw Error(source, line, "medium '" + m.name + "': " + e);
+    if (!media.empty() && !reads(st.integrator.type).media)
+        throw Error(source, line, std::string("the ") + integrator_type_name(st.integrator.type) +
+                                      " integrator does not render participating media (the scene has " +
+                                      std::to_string(media.size()) + "); use volpath");
+}
+
+}  // namespace
+
 std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::string& accel_name) {
     Mesh& mesh = desc.mesh;
     for (size_t i = 0; i < mesh.positions.size(); ++i)
@@ -194,6 +217,7 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters),
                        std::move(desc.lights)};
     check_params(desc.source, desc.shapes, params);
+    check_media(desc.source, desc.media_line, desc.media, desc.camera_medium, desc.shapes, params.settings);
 
     desc.mesh.compute_face_normals();
     for (ShapeGroup& g : desc.groups) g.mesh.compute_face_normals();
@@ -203,6 +227,8 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     geometry->analytic = std::move(desc.analytic);
     geometry->groups = std::move(desc.groups);
     geometry->instances = std::move(desc.instances);
+    geometry->media = std::move(desc.media);
+    geometry->camera_medium = desc.camera_medium;
     geometry->bounds = geometry->mesh.bounds();
     for (const AnalyticShape& a : geometry->analytic) geometry->bounds.expand(a.bounds());
     for (const Instance& in : geometry->instances) geometry->bounds.expand(in.bounds);
@@ -227,6 +253,7 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
 
 std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     check_params(source, shapes, p);
+    check_media(source, 0, geometry->media, geometry->camera_medium, shapes, p.settings);
     std::shared_ptr<const LightSet> lights_for = light_set;
     if (!same_emitters(emitters, p.emitters) || !same_lights(light_params, p.lights)) {
         auto rebuilt = std::make_shared<LightSet>();

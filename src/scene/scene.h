@@ -21,6 +21,7 @@
 #include "geometry/mesh.h"
 #include "integrator/desc.h"
 #include "light/area.h"
+#include "medium/medium.h"
 #include "sampling/sampler_desc.h"
 #include "scene/camera.h"
 
@@ -65,6 +66,9 @@ struct SceneDescription {
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
     std::vector<Light> lights;            // top-level emitters (light/emitter.h)
+    std::vector<Medium> media;            // participating media (Shape::interior/exterior index it)
+    int32_t camera_medium = -1;           // the medium around the sensor, or -1
+    int media_line = 0;                   // the line of the first medium element (for messages)
     Camera camera;
     RenderSettings settings;
     std::vector<std::string> warnings;   // non-fatal loader messages ("file: what") for the app to show
@@ -87,6 +91,8 @@ struct Geometry {
     std::vector<AnalyticShape> analytic;
     std::vector<ShapeGroup> groups;
     std::vector<Instance> instances;
+    std::vector<Medium> media;    // participating media (medium/medium.h); empty in most scenes
+    int32_t camera_medium = -1;   // the medium the camera rays start in, or -1
     AABB bounds;  // world: the scene's own primitives and every instance
 };
 

@@ -132,7 +132,7 @@ void Viewer::panel() {
         // The aov and moment wrappers need camera rays: only the integrators that take them
         // (integrator/caps.h) are offered with them.
         const bool wrapped = !st.integrator.aovs.empty();
-        static const char* const kLabels[] = {"path", "direct", "ptracer (light tracing)", "bdpt (bidirectional)",
+        static const char* const kLabels[] = {"path", "volpath (media)", "direct", "ptracer (light tracing)", "bdpt (bidirectional)",
                                               "pssmlt (Metropolis)", "mmlt (multiplexed Metropolis)"};
         static_assert(std::size(kLabels) == std::size(kIntegratorTypes));
         if (ImGui::BeginCombo("integrator", kLabels[std::find(std::begin(kIntegratorTypes), std::end(kIntegratorTypes),

@@ -791,7 +791,7 @@ uint32_t XmlLoader::material_for(Object& shape) {
         return c.tag == "ref" && object_by_id(c.node, required_attr(c.node, "id"), "").tag == "emitter";
     };
     for (Nested& c : shape.nested) {
-        if (refers_to_emitter(c)) continue;
+        if (refers_to_emitter(c) || is_medium_child(*this, c)) continue;  // the shape family's
         if (c.tag == "ref") definition(c, "bsdf");
         else if (c.tag != "bsdf") continue;
         if (found >= 0) throw error(c.node, "a shape takes one bsdf (another was given at line " + std::to_string(line(first)) + ")");
@@ -864,6 +864,8 @@ SceneDescription XmlLoader::load() {
                 load_emitter(*this, c);
             } else if (tag == "texture") {
                 load_texture(*this, c);  // checked now; used where a <ref> names it
+            } else if (tag == "medium") {
+                load_medium(*this, c);  // a medium that shapes or the sensor reference
             } else if (is_property_tag(tag) || tag == "ref") {
                 throw error(c, "unexpected <" + tag + "> directly inside <scene>");
             } else if (is_object_tag(tag)) {

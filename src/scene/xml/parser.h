@@ -119,6 +119,8 @@ public:
     int shape_counter = 0;  // shapes read so far (for default names)
     // Textures built so far, by element: one referenced several times is built once.
     std::map<const void*, std::shared_ptr<const Texture>> textures;
+    // Media built so far, by element: index into SceneDescription::media.
+    std::map<const void*, int32_t> media;
 
     // ---- bsdfs, shared by the shape and bsdf families ----
     // The material index of a bsdf element (built once even when referenced several times).

@@ -66,6 +66,16 @@ std::shared_ptr<const Texture> nested_texture(XmlLoader& L, Object& o, const std
 // A colour parameter given as a value or as a texture: the texture (a constant one for a value).
 std::shared_ptr<const Texture> rgb_or_texture(XmlLoader& L, Object& o, const std::string& name, vec3 def);
 
+// ---- media.cpp: <medium> (homogeneous, with its <phase>) -> SceneDescription::media ----
+// The index of the medium element (built once, whether nested or referenced).
+int32_t load_medium(XmlLoader& L, pugi::xml_node n);
+// Whether a nested object is a <medium> or a <ref> to one.
+bool is_medium_child(XmlLoader& L, const Nested& c);
+// The medium a nested <medium> or <ref> stands for, marked used.
+int32_t nested_medium(XmlLoader& L, Nested& c);
+// A shape's media named "interior" and "exterior" (left as they are when not given).
+void load_shape_media(XmlLoader& L, Object& shape, int32_t& interior, int32_t& exterior);
+
 // ---- integrators.cpp: <integrator> -> RenderSettings (factories: read_integrator,
 // scene/plugins/render_factories.h; this walks the moment/aov wrappers) ----
 void load_integrator(XmlLoader& L, pugi::xml_node n);

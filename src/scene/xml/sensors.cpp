@@ -128,6 +128,10 @@ void load_sensor(XmlLoader& L, pugi::xml_node n) {
             ms(L, sm, s);
             L.finish(sm);
             c.used = sampler = true;
+        } else if (is_medium_child(L, c)) {
+            // Mitsuba's sensor takes any medium among its objects, whatever its name.
+            if (L.scene().camera_medium >= 0) throw L.error(c.node, "a sensor takes one medium");
+            L.scene().camera_medium = nested_medium(L, c);
         }
     }
     L.finish(o);

@@ -208,10 +208,16 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
             throw L.error(c.node, "a textured radiance is supported on meshes only, not on a " + o.type);
         c.used = true;
     }
+    int32_t interior = -1, exterior = -1;
+    load_shape_media(L, o, interior, exterior);
     L.finish(o);
+    auto set_media = [&](uint32_t shape) {
+        L.scene().shapes[shape].interior = interior;
+        L.scene().shapes[shape].exterior = exterior;
+    };
     if (analytic) {
-        L.scene().add_analytic_shape(n.attribute("id") ? L.attr(n, "id") : o.type + std::to_string(L.shape_counter), a,
-                                     material, emitter);
+        set_media(L.scene().add_analytic_shape(
+            n.attribute("id") ? L.attr(n, "id") : o.type + std::to_string(L.shape_counter), a, material, emitter));
         return;
     }
 
@@ -237,7 +243,7 @@ void load_shape(XmlLoader& L, pugi::xml_node n) {
     std::string name = n.attribute("id") ? L.attr(n, "id")
                        : o.params.has("filename") ? o.params.get_string("filename", o.type)
                                          : o.type + std::to_string(L.shape_counter);
-    L.scene().add_shape(name, g.positions, g.normals, g.triangles, material, emitter, g.uvs, g.colors);
+    set_media(L.scene().add_shape(name, g.positions, g.normals, g.triangles, material, emitter, g.uvs, g.colors));
 }
 
 }  // namespace xml
