@@ -297,6 +297,7 @@ TEST(SplatFilter, SameSumsAtAnyThreadCount) {
         c.add_splats(one, sf);
         double sum = 0;
         for (const dvec3& v : c.splat_sums()) sum += v.x;
+        std::printf("  %-10s one interior splat's weights sum to %.4f\n", filter_name(f.type), sum);
         // The discretised weights' ripple; Lanczos's (31 steps over 3 lobes) is 11% here.
         if (f.type != FilterType::Lanczos) {
             EXPECT_NEAR(sum, 1.0, 0.05);

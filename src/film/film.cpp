@@ -120,7 +120,8 @@ void Film::add_splats(const std::vector<SplatTile>& tiles, const SplatFilter& fi
     }
     if (n == 0) return;
     if (splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
-    // Bands of rows: a few per thread (a splat's rows may fall in one band only); one for the box,
+    // Bands of rows: four per thread, for balance (a splat's rows may fall in one band only: the
+    // others skip it after a test of its rows); one for the box,
     // whose splats are a single addition each.
     const int bands = filter.is_box() || n_threads <= 1 ? 1 : std::min(height_, 4 * n_threads);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, n_threads)) if (bands > 1)

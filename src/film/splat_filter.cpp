@@ -1,5 +1,6 @@
 #include "film/splat_filter.h"
 #include <algorithm>
+#include <cmath>
 
 namespace candela {
 
@@ -28,20 +29,26 @@ void SplatFilter::add(dvec3* sums, vec2 pos, vec3 L, int row_begin, int row_end)
         if (y >= row_begin && y < row_end) sums[size_t(y) * size_t(width_) + size_t(x)] += dvec3(L);
         return;
     }
-    const float r = filter_.radius();
-    if (pos.y - 0.5f + r < float(row_begin) - 1.f || pos.y - 0.5f - r > float(row_end) + 1.f) return;  // clearly outside
+    // Its rows (as weights_1d finds them) against the band, before any weight is evaluated.
+    const float pfy = pos.y - 0.5f, r = filter_.radius();
+    if (int(std::floor(pfy + r)) < row_begin || int(std::ceil(pfy - r)) >= row_end) return;
     float wx[PixelFilter::kMaxReach], wy[PixelFilter::kMaxReach];
     int x0, y0;
-    const int nx = filter_.weights_1d(pos.x, 0, width_ - 1, x0, wx);
     const int ny = filter_.weights_1d(pos.y, 0, height_ - 1, y0, wy);
     const int j0 = std::max(0, row_begin - y0), j1 = std::min(ny, row_end - y0);
-    if (j0 >= j1) return;
+    if (j0 >= j1) return;  // none of its rows in this band
+    const int nx = filter_.weights_1d(pos.x, 0, width_ - 1, x0, wx);
     for (int i = 0; i < nx; ++i) wx[i] *= inv_wx_[size_t(x0 + i)];
-    const dvec3 v(L);
+    const double lx = double(L.x), ly = double(L.y), lz = double(L.z);
     for (int j = j0; j < j1; ++j) {
         const float wyj = wy[j] * inv_wy_[size_t(y0 + j)];
         dvec3* row = sums + size_t(y0 + j) * size_t(width_) + size_t(x0);
-        for (int i = 0; i < nx; ++i) row[i] += v * double(wx[i] * wyj);
+        for (int i = 0; i < nx; ++i) {
+            const double w = double(wx[i] * wyj);
+            row[i].x += lx * w;
+            row[i].y += ly * w;
+            row[i].z += lz * w;
+        }
     }
 }
 

@@ -51,13 +51,18 @@ PassStats splat_pass_units(Film& film, const FilterDesc& filter, uint32_t first_
             total_rays.fetch_add(ps.rays, std::memory_order_relaxed);
         }
         if (stopped) break;  // a partial sample index is dropped whole: every pixel keeps its count
+        uint64_t index_splats = 0;
         for (int u = 0; u < n_units; ++u) {
             const SplatTile& st = units[size_t(u)];
             merge_unit(u, layer);
-            splats += st.size();
+            index_splats += st.size();
             samples += st.paths;
         }
-        layer.add_splats(units, splat_filter, n_threads);  // in unit order (Film::add_splats)
+        splats += index_splats;
+        // In unit order (Film::add_splats), the threads sharing bands of rows only when there are
+        // many splats: on the loaded 2-core machine the extra parallel region per sample index
+        // cost more than it saved at 128 x 128 (docs/bdpt.md). The bytes are the same either way.
+        layer.add_splats(units, splat_filter, index_splats >= (uint64_t(1) << 18) ? n_threads : 1);
         film.add(layer);
     }
     PassStats out;
