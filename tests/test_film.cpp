@@ -1,5 +1,7 @@
 // Film accumulation (double sums, non-finite samples, counts) and the image block z-test of
-// tests/support/stats.h that image regression tests use against a committed reference.
+// tests/support/stats.h that image regression tests use against a committed reference; and the
+// splats through the film's filter (SplatFilter.*: the box's bytes, any thread count, and the
+// splat image's expectation against the camera samples', film/splat_filter.h).
 #include <gtest/gtest.h>
 #include <cmath>
 #include <cstdio>
