@@ -12,8 +12,10 @@
 //  * Ptracer_Furnace: the closed diffuse sphere lit by its own emission (tests/test_furnace.cpp):
 //    every pixel's exact value is Le (1 - a^(d+1)) / (1 - a); z-test over the pixel means with a
 //    3%-off control rejected at the same level.
-//  * Determinism: 1 and 2 threads, and 4 passes of 1 spp against 1 pass of 4, give the same film
-//    bit for bit (splats included); checkpoint and resume through the program (--integrator
+//  * Ptracer_FilteredSplatsAgreeWithPathAtSharpEdges: the splats through the film's gaussian and
+//    Mitchell filters against the path tracer's camera samples (support/agreement.h).
+//  * Determinism: 1, 2 and 3 threads, and 4 passes of 1 spp against 1 pass of 4, give the same
+//    film bit for bit (splats included), under the box and the gaussian filter; checkpoint and resume through the program (--integrator
 //    ptracer) end bit for bit as the uninterrupted render.
 //  * XML: <integrator type="ptracer"> with Mitsuba's max_depth, and a ptracer inside aov refused.
 #include <gtest/gtest.h>
@@ -122,6 +124,12 @@ TEST(Ptracer, VisibleDiffuseWall) {
     compare(lt, pt, "diffuse wall", 1, true);
 }
 
+// The light tracer's splats go through the film's filter (issue 41): a lit wall's edge, which the
+// gaussian and the Mitchell filter spread over the pixels around, against the path tracer's camera
+// samples under the same filter. Before, every splat landed in its pixel (a box) and the blocks
+// along the edge were rejected (the control).
+TEST(Ptracer, FilteredSplatsAgreeWithPathAtSharpEdges) { expect_filtered_splats_agree(IntegratorType::Ptracer, 32, 1700); }
+
 TEST(Ptracer, Furnace) {
     const std::vector<int> depths = {1, -1};
     const double level = sidak_level(kAlpha, int(depths.size()) * 3);
@@ -135,22 +143,29 @@ TEST(Ptracer, Furnace) {
     }
 }
 
+// The box filter (the built-in Cornell box's) and the gaussian, whose splats the merge spreads
+// over bands of rows shared out to the threads (Film::add_splats): 1, 2 and 3 threads.
 TEST(Ptracer, SameFilmAtAnyThreadCountAndPassSplit) {
     auto base = cornell(20);
-    SceneParams p = base->params();
-    p.settings.integrator.type = IntegratorType::Ptracer;
-    auto sc = base->with_params(p);
-    Film a(20, 20), b(20, 20), c(20, 20);
-    Renderer::render_pass(*sc, a, 0, 4, 1);
-    Renderer::render_pass(*sc, b, 0, 4, 2);
-    for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
-    ASSERT_FALSE(a.splat_sums().empty());
-    EXPECT_EQ(a.splat_paths(), 20u * 20u * 4u);
-    EXPECT_EQ(std::memcmp(a.splat_sums().data(), b.splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
-    EXPECT_EQ(std::memcmp(a.splat_sums().data(), c.splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
-    EXPECT_EQ(a.resolve(), b.resolve());
-    EXPECT_EQ(a.resolve(), c.resolve());
-    EXPECT_EQ(a.sample_count(3, 5), 4u);
+    for (const FilterDesc& f : {box_filter(), gaussian_filter()}) {
+        SCOPED_TRACE(filter_name(f.type));
+        SceneParams p = base->params();
+        p.settings.integrator.type = IntegratorType::Ptracer;
+        p.settings.filter = f;
+        auto sc = base->with_params(p);
+        Film a(20, 20), b(20, 20), c(20, 20), d(20, 20);
+        Renderer::render_pass(*sc, a, 0, 4, 1);
+        Renderer::render_pass(*sc, b, 0, 4, 2);
+        for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
+        Renderer::render_pass(*sc, d, 0, 4, 3);
+        ASSERT_FALSE(a.splat_sums().empty());
+        EXPECT_EQ(a.splat_paths(), 20u * 20u * 4u);
+        for (const Film* o : {&b, &c, &d}) {
+            EXPECT_EQ(std::memcmp(a.splat_sums().data(), o->splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
+            EXPECT_EQ(a.resolve(), o->resolve());
+        }
+        EXPECT_EQ(a.sample_count(3, 5), 4u);
+    }
 }
 
 TEST(Ptracer, CheckpointAndResumeKeepTheSplats) {

@@ -111,22 +111,25 @@ void FilmTile::reset(const Film& film, int tx0, int ty0, int tx1, int ty1, int m
     else alpha.clear();
 }
 
-void Film::add_splat(vec2 pos, vec3 L) {
-    if (!(pos.x >= 0.f && pos.y >= 0.f && pos.x < float(width_) && pos.y < float(height_))) return;
-    if (!all_finite(L)) {
-        nonfinite_.fetch_add(1, std::memory_order_relaxed);
-        return;
+void Film::add_splats(const std::vector<SplatTile>& tiles, const SplatFilter& filter, int n_threads) {
+    size_t n = 0;
+    for (const SplatTile& t : tiles) {
+        n += t.size();
+        splat_paths_ += t.paths;
+        if (t.nonfinite) nonfinite_.fetch_add(t.nonfinite, std::memory_order_relaxed);
     }
+    if (n == 0) return;
     if (splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
-    const int x = std::min(int(pos.x), width_ - 1), y = std::min(int(pos.y), height_ - 1);
-    splat_[size_t(y) * size_t(width_) + size_t(x)] += dvec3(L);
-}
-
-void Film::add_splats(const SplatTile& t) {
-    if (!t.pixel.empty() && splat_.empty()) splat_.assign(sum_.size(), dvec3(0.0));
-    for (size_t k = 0; k < t.pixel.size(); ++k) splat_[t.pixel[k]] += dvec3(t.value[k]);
-    splat_paths_ += t.paths;
-    if (t.nonfinite) nonfinite_.fetch_add(t.nonfinite, std::memory_order_relaxed);
+    // Bands of rows: four per thread, for balance (a splat's rows may fall in one band only: the
+    // others skip it after a test of its rows); one for the box,
+    // whose splats are a single addition each.
+    const int bands = filter.is_box() || n_threads <= 1 ? 1 : std::min(height_, 4 * n_threads);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(1, n_threads)) if (bands > 1)
+    for (int b = 0; b < bands; ++b) {
+        const int y0 = int(int64_t(height_) * b / bands), y1 = int(int64_t(height_) * (b + 1) / bands);
+        for (const SplatTile& t : tiles)
+            for (size_t k = 0; k < t.size(); ++k) filter.add(splat_.data(), t.pos[k], t.value[k], y0, y1);
+    }
 }
 
 void Film::restore_splats(std::vector<dvec3> sums, uint64_t paths) {

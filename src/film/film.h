@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 #include "core/math.h"
+#include "film/splat_filter.h"
 
 namespace candela {
 
@@ -79,18 +80,21 @@ public:
     const std::vector<double>& alpha_sums() const { return alpha_; }
     void restore_alpha(std::vector<double> sums);
 
-    // ---- Splats: contributions of light paths (light tracing, BDPT's t = 1), which land anywhere.
-    // They are summed per pixel in a buffer of their own (allocated when first used), beside the
-    // count of light paths traced (`splat_paths`), and a pixel resolves to
+    // ---- Splats: contributions of light paths (light tracing, BDPT's t = 1, MLT), which land anywhere.
+    // They go through the film's filter (film/splat_filter.h) into a buffer of their own
+    // (allocated when first used), beside the count of light paths traced (`splat_paths`), and a
+    // pixel resolves to
     //     sum(samples) / count  +  splat_sum x N / splat_paths,
     // N the number of pixels: each light path is a sample of the whole image (the camera's We is
     // normalised over the image, scene/camera.h), so with one light path per pixel sample
     // (splat_paths = spp x N) the splats are divided by the samples per pixel.
     // Deterministic at any thread count: threads never touch the film's splats; each tile fills a
-    // SplatTile in its own sample order, and the pass merges the tiles in tile order (add_splats).
-    // add_splat and add_splats are NOT thread safe: one thread at a time.
-    void add_splat(vec2 image_pos, vec3 L);  // image pixels; outside the image: dropped
-    void add_splats(const struct SplatTile& tile);
+    // SplatTile with (position, value) in its own sample order, and add_splats spreads the tiles'
+    // splats over their pixels in tile order, then splat order: with n_threads > 1 and a filter
+    // wider than the box, threads share out bands of rows, each adding every splat's share of its
+    // rows, so each pixel's sum takes its terms in that order whatever the threads. Call from one
+    // thread.
+    void add_splats(const std::vector<struct SplatTile>& tiles, const SplatFilter& filter, int n_threads = 1);
     bool has_splats() const { return !splat_.empty() || splat_paths_ > 0; }
     uint64_t splat_paths() const { return splat_paths_; }
     const std::vector<dvec3>& splat_sums() const { return splat_; }  // empty when none
@@ -188,28 +192,28 @@ private:
     std::vector<uint8_t> active_;
 };
 
-// A tile's splats in the order its light paths made them (pixel index, value), and how many light
-// paths it traced. Reused across tiles: clear() keeps the capacity.
+// A tile's splats in the order its light paths made them (film position, value), and how many
+// light paths it traced. Reused across tiles: clear() keeps the capacity.
 struct SplatTile {
-    std::vector<uint32_t> pixel;
+    std::vector<vec2> pos;
     std::vector<vec3> value;
     uint64_t paths = 0;
     uint64_t nonfinite = 0;
     void clear() {
-        pixel.clear();
+        pos.clear();
         value.clear();
         paths = 0;
         nonfinite = 0;
     }
-    // Image position (pixels) -> the pixel it lands in; outside the image or non-finite: dropped.
-    void add(int width, int height, vec2 pos, vec3 L) {
-        if (!(pos.x >= 0.f && pos.y >= 0.f && pos.x < float(width) && pos.y < float(height))) return;
+    size_t size() const { return pos.size(); }
+    // Image position (pixels); outside the image or non-finite: dropped.
+    void add(int width, int height, vec2 p, vec3 L) {
+        if (!(p.x >= 0.f && p.y >= 0.f && p.x < float(width) && p.y < float(height))) return;
         if (!all_finite(L)) {
             ++nonfinite;
             return;
         }
-        const int x = std::min(int(pos.x), width - 1), y = std::min(int(pos.y), height - 1);
-        pixel.push_back(uint32_t(y) * uint32_t(width) + uint32_t(x));
+        pos.push_back(p);
         value.push_back(L);
     }
 };

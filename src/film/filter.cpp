@@ -71,6 +71,14 @@ PixelFilter::PixelFilter(const FilterDesc& d) : desc_(d) {
     reach_ = int(std::floor(radius_ + 0.5f));
 }
 
+double PixelFilter::cumulative(double t) const {
+    const double a = std::abs(t), bin = double(radius_) / double(kResolution);
+    double sum = 0.0;
+    for (int i = 0; i < kResolution && a > double(i) * bin; ++i)
+        sum += double(values_[i]) * (std::min(a, double(i + 1) * bin) - double(i) * bin);
+    return t < 0.0 ? -sum : sum;
+}
+
 float PixelFilter::eval(float x) const {
     switch (desc_.type) {
         case FilterType::Box: return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f;

@@ -9,6 +9,8 @@
 // pixel's value is a ratio estimator, consistent but not unbiased at low sample counts.
 // Weights are Mitsuba's discretised ones: the 1D filter tabulated at 31 points over [0, radius),
 // looked up by truncation (ReconstructionFilter::eval_discretized), evaluated in float.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace candela {
@@ -59,8 +61,26 @@ public:
         uint32_t i = uint32_t(a * scale_);
         return values_[i < uint32_t(kResolution) ? i : uint32_t(kResolution)];
     }
+    // The pixels along one axis that a sample at film coordinate p reaches: those whose centres
+    // (i + 0.5) lie within the radius of p, clipped to [lo, hi]. Writes their discretised weights,
+    // the first pixel's weight at w[0], to w (room for kMaxReach), sets `first` and returns their
+    // number (0: none). Mitsuba's ImageBlock::put; camera samples and splats both use it.
+    static constexpr int kMaxReach = 2 * 64 + 2;  // the XML reader caps radii at 64 pixels
+    int weights_1d(float p, int lo, int hi, int& first, float* w) const {
+        const float pf = p - 0.5f;  // pixel centres are at integers + 0.5
+        first = std::max(int(std::ceil(pf - radius_)), lo);
+        const int last = std::min(int(std::floor(pf + radius_)), hi);
+        if (first > last) return 0;
+        const int n = std::min(last - first + 1, kMaxReach);
+        float r = float(first) - pf;
+        for (int i = 0; i < n; ++i, r += 1.f) w[i] = eval_discretized(r);
+        return n;
+    }
+    // The integral of the discretised filter over [a, b] (pixels), exact for its steps.
+    double integral_discretized(double a, double b) const { return cumulative(b) - cumulative(a); }
 
 private:
+    double cumulative(double t) const;  // the integral over [0, t], odd in t
     FilterDesc desc_;
     float radius_ = 0.5f, scale_ = 0.f;
     float inv_radius_ = 2.f;           // tent: 1 - |x inv_radius|

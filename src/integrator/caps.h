@@ -41,16 +41,17 @@ inline constexpr IntegratorCaps kPathCaps    {true,   true,   true,  true,  true
 inline constexpr IntegratorCaps kVolpathCaps {true,   true,   true,  true,  true,  true,  true,  true,  true,  true,  true,  true,  false};
 // direct: emitter_samples and bsdf_samples instead of the sampling mode; one scattering event.
 inline constexpr IntegratorCaps kDirectCaps  {false,  true,   true,  false, false, true,  true,  true,  true,  true,  true,  false, false};
-// ptracer: splats land in the pixel they project to (a box) whatever the film's filter.
-inline constexpr IntegratorCaps kPtracerCaps {false,  true,   false, true,  true,  true,  true,  false, false, true,  true,  false, false};
-// bdpt: every (s, t) strategy weighted by MIS, whatever the sampling mode.
+// ptracer: its splats go through the film's filter (film/splat_filter.h).
+inline constexpr IntegratorCaps kPtracerCaps {false,  true,   true,  true,  true,  true,  true,  false, false, true,  true,  false, false};
+// bdpt: every (s, t) strategy weighted by MIS, whatever the sampling mode; t = 1 splats filtered.
 inline constexpr IntegratorCaps kBdptCaps    {false,  true,   true,  true,  true,  true,  true,  false, false, true,  true,  false, false};
-// pssmlt: the path tracer (with its sampling mode) on the chains' own primary samples, box splats.
+// pssmlt: the path tracer (with its sampling mode) on the chains' own primary samples, splats
+// through the film's filter.
 // No MPI: the chains carry state from one sample index to the next and the film is scaled by a b
 // refined as they run, so sample indices cannot go to ranks independently (docs/distributed.md).
-inline constexpr IntegratorCaps kPssmltCaps  {true,   false,  false, true,  true,  true,  false, false, false, true,  true,  false, false};
-// mmlt: BDPT's strategies on the chains' own primary samples, box splats; no MPI, as pssmlt.
-inline constexpr IntegratorCaps kMmltCaps    {false,  false,  false, true,  true,  true,  false, false, false, true,  true,  false, false};
+inline constexpr IntegratorCaps kPssmltCaps  {true,   false,  true,  true,  true,  true,  false, false, false, true,  true,  false, false};
+// mmlt: BDPT's strategies on the chains' own primary samples, filtered splats; no MPI, as pssmlt.
+inline constexpr IntegratorCaps kMmltCaps    {false,  false,  true,  true,  true,  true,  false, false, false, true,  true,  false, false};
 // clang-format on
 
 constexpr const IntegratorCaps& reads(IntegratorType t) {

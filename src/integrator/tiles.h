@@ -42,19 +42,11 @@ namespace detail {
 // of `pos`, with separable discretised weights evaluated in float.
 inline void splat(FilmTile& t, const PixelFilter& f, int film_w, int film_h, vec2 pos, vec3 L, const float* aov,
                   bool covered = false) {
-    constexpr int kMax = 2 * 64 + 2;  // the XML reader caps radii at 64 pixels
-    const float r = f.radius();
-    const vec2 pf = pos - 0.5f;  // pixel centres are at integers + 0.5
-    const int lo_x = std::max(int(std::ceil(pf.x - r)), std::max(0, t.x0));
-    const int hi_x = std::min(int(std::floor(pf.x + r)), std::min(film_w, t.x0 + t.width) - 1);
-    const int lo_y = std::max(int(std::ceil(pf.y - r)), std::max(0, t.y0));
-    const int hi_y = std::min(int(std::floor(pf.y + r)), std::min(film_h, t.y0 + t.height) - 1);
-    if (lo_x > hi_x || lo_y > hi_y) return;
-    float wx[kMax], wy[kMax];
-    const int nx = std::min(hi_x - lo_x + 1, kMax), ny = std::min(hi_y - lo_y + 1, kMax);
-    float rx = float(lo_x) - pf.x, ry = float(lo_y) - pf.y;
-    for (int i = 0; i < nx; ++i, rx += 1.f) wx[i] = f.eval_discretized(rx);
-    for (int i = 0; i < ny; ++i, ry += 1.f) wy[i] = f.eval_discretized(ry);
+    float wx[PixelFilter::kMaxReach], wy[PixelFilter::kMaxReach];
+    int lo_x, lo_y;
+    const int nx = f.weights_1d(pos.x, std::max(0, t.x0), std::min(film_w, t.x0 + t.width) - 1, lo_x, wx);
+    const int ny = f.weights_1d(pos.y, std::max(0, t.y0), std::min(film_h, t.y0 + t.height) - 1, lo_y, wy);
+    if (nx == 0 || ny == 0) return;
     // (L, 1) w added to (sum, weight) as two pairs of doubles (GCC/Clang vector extensions, any
     // target): two multiplies and two adds per pixel. Each sum gets the operations that separate
     // adds would give it, so the image is the same bit for bit.

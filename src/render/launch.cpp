@@ -61,7 +61,7 @@ void check_reads(SceneDescription& desc, const SceneOverrides& ov) {
                  " (its Markov chains draw their own random numbers)");
     }
     if (!c.filter && !st.filter.is_box())
-        note(std::string("the film's ") + filter_name(st.filter.type) + " filter (its splats land in one pixel)");
+        note(std::string("the film's ") + filter_name(st.filter.type) + " filter");
     const int scene_max_depth = max_depth_to_mitsuba(st.max_depth);
     if (!c.max_depth) {
         if (ov.max_depth) refuse("--max-depth", "it has no depth");

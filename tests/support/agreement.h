@@ -66,4 +66,18 @@ SceneDescription smooth_ball_description(int res);
 // cosine (what a ray hitting the lamp sees), not the shading one.
 SceneDescription tilted_lamp_description(int res);
 
+// ---- filtered splats ------------------------------------------------------------------------
+// A diffuse wall filling the left half of the view of a camera at z = 4 (its edge, x = 0, on the
+// image's middle column, a 4 x 4 block boundary when res is a multiple of 8), nothing on the
+// right, lit by a small lamp in front of it (its black back in view) aimed at the edge. Near the
+// edge BDPT's t = 1 strategies take most of the MIS weight (the lamp's density of reaching the
+// wall, cos / (pi d^2), is above the camera's there); the light tracer's image is all splats.
+SceneDescription lit_edge_description(int res);
+
+// `type` against the path tracer on that wall (res 16) under the gaussian and the Mitchell
+// filter: block and whole-image z-tests (expect_agreement); control: `type` under the box filter,
+// its splats in the pixel they land in, against the path tracer under each filter, rejected by
+// the block test (the filtered edges spill into the blocks outside the lamp).
+void expect_filtered_splats_agree(IntegratorType type, int spp, uint64_t seed_base);
+
 }  // namespace candela::test

@@ -539,7 +539,15 @@ ImageEstimate ImageEstimate::from_batches(const std::vector<const Film*>& batche
     im.var_of_mean.assign(n, dvec3(0.0));
     // A weighted film (tent, gaussian) normalises by its weight sums, a box-filtered one by counts;
     // the batch means are then ratio estimators, whose spread still gives the variance.
-    auto norm = [](const Film* f, size_t i) { return f->weighted() ? f->weights()[i] : double(f->counts()[i]); };
+    // A film of splats only (the light tracer on a weighted film: no camera weights): every batch
+    // weighs the same.
+    bool splats_only = true;
+    for (const Film* f : batches)
+        for (size_t i = 0; i < f->weights().size() && splats_only; ++i) splats_only = f->weights()[i] == 0.0;
+    for (const Film* f : batches) splats_only = splats_only && f->weighted() && f->has_splats();
+    auto norm = [&](const Film* f, size_t i) {
+        return splats_only ? 1.0 : f->weighted() ? f->weights()[i] : double(f->counts()[i]);
+    };
     for (size_t i = 0; i < n; ++i) {
         double total = 0;
         dvec3 sum(0.0);

@@ -271,7 +271,7 @@ PassStats bdpt_pass(const Scene& scene, Film& film, uint32_t first_sample, int s
     auto merge_tile = [&](int tile, const detail::TileRange&, Film& layer) {
         if (weighted) layer.merge(ftiles[size_t(tile)]);
     };
-    return splat_pass(film, first_sample, spp, n_threads, cancel, work, merge_tile);
+    return splat_pass(film, scene.settings.filter, first_sample, spp, n_threads, cancel, work, merge_tile);
 }
 
 }  // namespace
@@ -300,6 +300,8 @@ std::vector<StrategyImage> render_bdpt_strategies(const Scene& scene, int w, int
             out.push_back({s, len + 2 - s, std::vector<float>(size_t(w) * size_t(h) * 3, 0.f),
                            std::vector<float>(size_t(w) * size_t(h) * 3, 0.f)});
     std::vector<dvec3> sum_w(out.size() * size_t(w) * size_t(h)), sum_u(sum_w.size());
+    // Each strategy's image unfiltered (a box), camera samples and splats alike.
+    const SplatFilter box(box_filter(), w, h);
     const int rows_per_chunk = 1;
     const int n_chunks = (h + rows_per_chunk - 1) / rows_per_chunk;
     std::vector<std::vector<std::pair<uint32_t, StrategyRecord>>> recs(static_cast<size_t>(n_chunks));
@@ -329,15 +331,16 @@ std::vector<StrategyImage> render_bdpt_strategies(const Scene& scene, int w, int
                 for (const auto& [pix, e] : r) {
                     const int k = index(e.s, e.t);
                     if (k < 0) continue;
-                    uint32_t p = pix;
-                    if (e.splat) {
+                    const size_t base = size_t(k) * size_t(w) * size_t(h);
+                    if (e.splat) {  // in the pixel it lands in, as the camera samples here
                         if (!(e.raster.x >= 0.f && e.raster.y >= 0.f && e.raster.x < float(w) && e.raster.y < float(h)))
                             continue;
-                        p = uint32_t(std::min(int(e.raster.y), h - 1)) * uint32_t(w) + uint32_t(std::min(int(e.raster.x), w - 1));
+                        box.add(&sum_w[base], e.raster, e.weighted, 0, h);
+                        box.add(&sum_u[base], e.raster, e.unweighted, 0, h);
+                        continue;
                     }
-                    const size_t j = size_t(k) * size_t(w) * size_t(h) + p;
-                    sum_w[j] += dvec3(e.weighted);
-                    sum_u[j] += dvec3(e.unweighted);
+                    sum_w[base + pix] += dvec3(e.weighted);
+                    sum_u[base + pix] += dvec3(e.unweighted);
                 }
         }
     });

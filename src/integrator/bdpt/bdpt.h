@@ -7,12 +7,13 @@
 // the power heuristic over all strategies that could have made that path (bdpt/mis.h):
 //   s = 0       the camera path reaches an emitter (area light) or leaves the scene (infinite lights)
 //   s = 1       next-event estimation from z_{t-1}: a fresh light sample (LightSet::sample_li)
-//   t = 1       y_{s-1} connected to the camera (Camera::sample_wi), SPLATTED at the pixel it
-//               projects to (as the light tracer, integrator/ptracer/); not for the
+//   t = 1       y_{s-1} connected to the camera (Camera::sample_wi), SPLATTED where it projects,
+//               through the film's filter (as the light tracer, film/splat_filter.h); not for the
 //               orthographic camera (a delta direction) nor to an infinite light
 //   s, t >= 2   y_{s-1} and z_{t-1} joined by a shadow ray
-// The camera sample's own value (t >= 2) goes to its pixel; the splats are normalised by the light
-// paths traced (film/film.h), one per pixel sample, so the image is their sum.
+// The camera sample's own value (t >= 2) goes to the film at its position (filtered as every camera
+// sample); the splats are normalised by the light paths traced (film/film.h), one per pixel
+// sample, and by the filter so that both estimate the same filtered image: the image is their sum.
 //
 // Densities: every vertex stores pdf_fwd and pdf_rev in AREA measure (solid angle x |cos| /
 // dist^2 at the receiving vertex; a direction, y_0 of an infinite light or z where the camera
@@ -139,8 +140,8 @@ public:
 };
 
 // --bdpt-strategies: one image per strategy (s, t) with s + t - 2 <= max_length, weighted and
-// unweighted, over `spp` samples (each a film's resolved mean: the weighted ones sum to the
-// BDPT image). Returned per strategy in order of (length, s).
+// unweighted, over `spp` samples (each a film's resolved mean, unfiltered: the weighted ones sum
+// to the BDPT image under the box filter). Returned per strategy in order of (length, s).
 struct StrategyImage {
     int s, t;
     std::vector<float> weighted, unweighted;  // RGB, row-major

@@ -514,7 +514,7 @@ PassStats mlt_pass(const Evaluator& ev, const Scene& scene, Film& film, uint32_t
                 for (int x = 0; x < w; ++x) layer.count_sample(ivec2(x, y));
         if (c == n_chains - 1) end_index(set);  // the index is whole: refine b for the next
     };
-    PassStats out = splat_pass_units(film, first_sample, spp, threads, cancel, n_chains, work, merge);
+    PassStats out = splat_pass_units(film, scene.settings.filter, first_sample, spp, threads, cancel, n_chains, work, merge);
     out.rays += rays + replay_rays.load();
     if (!out.completed) {
         // The film holds the indices completed before the cut (each adds N mutations): the stats

@@ -31,7 +31,7 @@ PassStats light_tracer_pass(const Scene& scene, Film& film, uint32_t first_sampl
         for (int y = tr.y0; y < tr.y1; ++y)
             for (int x = tr.x0; x < tr.x1; ++x) layer.count_sample(ivec2(x, y));
     };
-    return splat_pass(film, first_sample, spp, n_threads, cancel, work, merge_tile);
+    return splat_pass(film, scene.settings.filter, first_sample, spp, n_threads, cancel, work, merge_tile);
 }
 
 }  // namespace

@@ -31,8 +31,9 @@
 // Sampler dimensions per light path: [emitters seen directly: 1 (light), 2 (point or direction),
 // 2 (lens)], then 1 (light), 2 (position), 2 (direction), and per vertex 2 (lens), 1 + 2 (BSDF),
 // [1 (roulette)]; masks add 1 per masked surface reached.
-// Limits: the splat lands in the pixel it projects to (a box filter) whatever the film's filter;
-// perturbed normals (bump, normal maps) use the interpolated shading normal in C; no alpha, no AOVs.
+// The splats go through the film's filter (film/splat_filter.h): the image estimates the same
+// filtered image as the path tracer's camera samples.
+// Limits: perturbed normals (bump, normal maps) use the interpolated shading normal in C; no alpha, no AOVs.
 #include "integrator/integrator.h"
 #include "integrator/path.h"
 
