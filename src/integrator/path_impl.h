@@ -9,6 +9,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     const Scene& sc = scene_;
     const bool hide = sc.settings.integrator.hide_emitters;
     const bool masks = !DiffuseOnly && masks_;
+    const BounceSettings bset(sc, masks);
     PathState p;
     p.ray = ray;
     ShadingT<DiffuseOnly> sh;
@@ -25,7 +26,7 @@ vec3 PathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         if (depth == 0 && p.passes == 0) ++stats.camera_hits;
         SurfaceInteraction si = sc.interaction(hit);
         const BounceResult b =
-            path_bounce<DiffuseOnly>(sc, hit, si, depth, masks, p, sampler, sh, stats, [&](const ShadowRequest& r) {
+            path_bounce<DiffuseOnly>(sc, bset, hit, si, depth, p, sampler, sh, stats, [&](const ShadowRequest& r) {
                 const float T = shadow_transmittance(sc, r.ray, masks, stats.rays);
                 if (T > 0.f) p.L += r.contribution(T);
             });

@@ -2,7 +2,6 @@
 // and std::min written as the selects they are; next_float_up/down as integer steps on the bits.
 #include "integrator/path/diffuse_step.h"
 #include "core/math.h"
-#include "integrator/path/rules.h"
 
 #ifndef HWY_DISABLED_TARGETS
 #define HWY_DISABLED_TARGETS (HWY_AVX3 | HWY_AVX3_DL)
@@ -34,6 +33,11 @@ struct LaneOps {
     static MF is_inf(VF a) { return hn::IsInf(a); }
     static VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
 };
+
+// The per-path bounce's rules compiled for this target (see rules.inc).
+namespace path_rules {
+#include "integrator/path/rules.inc"
+}  // namespace path_rules
 
 // offset_ray_origin (geometry/interaction.h) per lane: p offset along n by the error bound, on the
 // side of w, then rounded away from the surface (next_float_up/down as integer steps).

@@ -113,6 +113,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
     x.reserve((paths.size() + kAlign - 1) / kAlign * kAlign);
     ShadingT<true> sh;   // a lane's shading, when its light sample is made per path
     ShadingT<false> shg; // another hit's
+    const BounceSettings bset(sc, false);  // no masks in the scope
     // Every live path is at the same depth: they start together and each round is one bounce.
     for (int depth = 0; !live.empty(); ++depth) {
         x.next.clear();
@@ -211,7 +212,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             StagedPath<S>& p = paths[i];
             SurfaceInteraction si = sc.interaction(hit);
             const BounceResult b =
-                path_bounce<false>(sc, hit, si, depth, false, p, p.sampler, shg, stats, [&](const ShadowRequest& r) {
+                path_bounce<false>(sc, bset, hit, si, depth, p, p.sampler, shg, stats, [&](const ShadowRequest& r) {
                     queue_shadow(p, r);
                     x.shadowed.push_back(i);
                 });
@@ -416,32 +417,15 @@ PassStats render_staged_for(const Scene& scene, Film& film, uint32_t first_sampl
 #define CANDELA_STAGED_EXTERN(S)                                                                           \
     extern template PassStats render_staged_for<S>(const Scene&, Film&, uint32_t, int, int,             \
                                                    const std::atomic<bool>*);
-CANDELA_STAGED_EXTERN(StratifiedSampler)
-CANDELA_STAGED_EXTERN(MultijitterSampler)
-CANDELA_STAGED_EXTERN(LdSampler)
-CANDELA_STAGED_EXTERN(SobolSampler)
-CANDELA_STAGED_EXTERN(ZSobolSampler)
-CANDELA_STAGED_EXTERN(OrthogonalSampler)
+CANDELA_FOR_EACH_SAMPLER_COMPILED_APART(CANDELA_STAGED_EXTERN)
 #undef CANDELA_STAGED_EXTERN
 
 inline PassStats render_staged_sampled_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp,
                                             int n_threads, const std::atomic<bool>* cancel) {
-    switch (scene.settings.sampler.type) {
-        case SamplerType::Stratified:
-            return render_staged_for<StratifiedSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Multijitter:
-            return render_staged_for<MultijitterSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::LdSampler:
-            return render_staged_for<LdSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Sobol:
-            return render_staged_for<SobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::ZSobol:
-            return render_staged_for<ZSobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Orthogonal:
-            return render_staged_for<OrthogonalSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Independent: break;
-    }
-    return render_staged_for<IndependentSampler>(scene, film, first_sample, spp, n_threads, cancel);
+    return visit_sampler_type(scene.settings.sampler.type, [&](auto tag) {
+        using S = typename decltype(tag)::type;
+        return render_staged_for<S>(scene, film, first_sample, spp, n_threads, cancel);
+    });
 }
 
 }  // namespace candela
