@@ -100,8 +100,9 @@ struct ShadowRequest {
 // The light sample at a shaded vertex with the numbers (ul chooses the light, up the point):
 // false when there is none or the BSDF is black there; else its request.
 template <bool DiffuseOnly>
-__attribute__((always_inline)) inline bool light_sample(const Scene& sc, const SurfaceInteraction& si, const ShadingT<DiffuseOnly>& sh, vec3 beta,
-                         float ul, vec2 up, ShadowRequest& r) {
+__attribute__((always_inline)) inline bool light_sample(const Scene& sc, const SurfaceInteraction& si,
+                                                        const ShadingT<DiffuseOnly>& sh, vec3 beta, float ul, vec2 up,
+                                                        ShadowRequest& r) {
     LightSample ls;
     if (!sc.lights.sample_li(si.p, ul, up, ls)) return false;
     const BsdfEval e = sh.eval_pdf(sh.frame.to_local(ls.wi));  // f, and the pdf for MIS, from one evaluation
@@ -154,8 +155,9 @@ struct BounceSettings {
 // the mode is not Bsdf, even when no light sample is made, so that dimensions stay aligned), BSDF
 // (1D then 2D), roulette (1D, when it applies). The staged loop's lanes draw the same (wavefront.h).
 // `sh` is scratch kept by the caller (one per path loop). Returns Continue when the path goes on
-// along p.ray, End when it ends; a PassThrough continues p.ray at the same depth. Inlined into each loop, as the loop body it was (measured: called,
-// it cost the per-path loop 3-4% more instructions per sample).
+// along p.ray, End when it ends; PassThrough continues p.ray at the same depth. Inlined into each
+// loop, as the loop body it was (measured: called, it cost the per-path loop 3-4% more
+// instructions per sample).
 template <bool DiffuseOnly, class S, class Shadow>
 __attribute__((always_inline)) inline BounceResult path_bounce(const Scene& sc, const BounceSettings& cfg, const Hit& hit,
                                                                SurfaceInteraction& si, int depth, PathState& p,

@@ -7,16 +7,17 @@
 //      hit on the scene's own triangles with a plain, untextured diffuse material takes a lane;
 //   2. the lanes' hit reconstruction in SIMD lanes (hit_soa.h), then per lane emission and the
 //      numbers of this bounce, drawn in Li's order. Every other hit (other materials, analytic
-//      shapes, instances) makes its whole bounce here, per path, as Li does;
+//      shapes, instances) makes its whole bounce here, per path: path_bounce (path/bounce.h), the
+//      function Li runs, its shadow ray queued for stage 4;
 //   3. in SIMD lanes: the shading (frame, wo, albedo), the light samples when the lights are
 //      emissive triangles (the shadow ray and its contribution, computed as if unoccluded; per
 //      path otherwise) and the diffuse step: BSDF sample, throughput, next ray, roulette
 //      (diffuse_step.h);
 //   4. the round's shadow rays; each adds its contribution when unoccluded (the shadow ray's
 //      outcome changes no sampler draw and no throughput, so the path went on before).
-// Each path makes the operations of PathIntegrator::Li (path_impl.h) in the same order, and the
-// film gets the samples in the scalar loop's order: the image is the same bit for bit
-// (tests/test_staged.cpp compares the films on every SIMD target).
+// Each path makes the operations of PathIntegrator::Li (path_impl.h, path/bounce.h) in the same
+// order, and the film gets the samples in the scalar loop's order: the image is the same bit for
+// bit (tests/test_staged.cpp compares the films on every SIMD target).
 //
 // Scope (staged_pass_applies): scenes without masks or textured emitters, any sampler, films
 // without adaptive sampling, AOVs or alpha (any pixel filter). The path pass uses the per-path
