@@ -1,14 +1,10 @@
 #pragma once
 #include "scene/scene.h"
 #include "sampling/sampler.h"
+#include "integrator/path/bounce.h"
 #include "integrator/shading.h"
 
 namespace candela {
-
-struct PathStats {
-    uint64_t rays = 0;  // closest-hit and shadow rays traced
-    uint64_t camera_hits = 0;  // camera rays that hit a surface (the film's alpha: hdrfilm rgba)
-};
 
 // Unidirectional path tracing with next-event estimation, combined with BSDF sampling by the
 // power heuristic (Veach 1997) in Mis mode. Light mode counts emission only through light

@@ -385,19 +385,45 @@ inline IndependentSampler make_sampler<IndependentSampler>(const SamplerSetup& s
     return IndependentSampler(s.seed);
 }
 
+// A sampler type as a value: SamplerTag<S>::type is S.
+template <class S>
+struct SamplerTag {
+    using type = S;
+};
+
+// The one dispatch on the sampler type: calls f(SamplerTag<S>{}) for the class S of `type`, so
+// that f is instantiated once per sampler class and chosen once per pass (every pass, per-path or
+// staged, path or direct or BDPT, goes through here).
+template <class F>
+decltype(auto) visit_sampler_type(SamplerType type, F&& f) {
+    switch (type) {
+        case SamplerType::Stratified: return f(SamplerTag<StratifiedSampler>{});
+        case SamplerType::Multijitter: return f(SamplerTag<MultijitterSampler>{});
+        case SamplerType::LdSampler: return f(SamplerTag<LdSampler>{});
+        case SamplerType::Sobol: return f(SamplerTag<SobolSampler>{});
+        case SamplerType::ZSobol: return f(SamplerTag<ZSobolSampler>{});
+        case SamplerType::Orthogonal: return f(SamplerTag<OrthogonalSampler>{});
+        case SamplerType::Independent: break;
+    }
+    return f(SamplerTag<IndependentSampler>{});
+}
+
+// X(S) for each sampler class but the independent one: the instantiations compiled apart, each in
+// its own translation unit (integrator/samplers/), declared extern where the passes are dispatched.
+#define CANDELA_FOR_EACH_SAMPLER_COMPILED_APART(X) \
+    X(StratifiedSampler)                           \
+    X(MultijitterSampler)                          \
+    X(LdSampler)                                   \
+    X(SobolSampler)                                \
+    X(ZSobolSampler)                               \
+    X(OrthogonalSampler)
+
 // Calls f(sampler) with the sampler the setup names, constructed: one instantiation of f per type.
 template <class F>
 decltype(auto) visit_sampler(const SamplerSetup& s, F&& f) {
-    switch (s.desc.type) {
-        case SamplerType::Stratified: return f(StratifiedSampler(s));
-        case SamplerType::Multijitter: return f(MultijitterSampler(s));
-        case SamplerType::LdSampler: return f(LdSampler(s));
-        case SamplerType::Sobol: return f(SobolSampler(s));
-        case SamplerType::ZSobol: return f(ZSobolSampler(s));
-        case SamplerType::Orthogonal: return f(OrthogonalSampler(s));
-        case SamplerType::Independent: break;
-    }
-    return f(IndependentSampler(s.seed));
+    return visit_sampler_type(s.desc.type, [&](auto tag) -> decltype(auto) {
+        return f(make_sampler<typename decltype(tag)::type>(s));
+    });
 }
 
 }  // namespace candela

@@ -17,6 +17,28 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+// The operations path_rules (path/rules.h) applies, on a vector of lanes: the per-path bounce's
+// rules, lane by lane.
+template <class D>
+struct LaneOps {
+    using VF = hn::Vec<D>;
+    using MF = hn::Mask<D>;
+    D d;
+    VF set(float x) const { return hn::Set(d, x); }
+    static VF mul(VF a, VF b) { return hn::Mul(a, b); }
+    static VF add(VF a, VF b) { return hn::Add(a, b); }
+    static VF div(VF a, VF b) { return hn::Div(a, b); }
+    static MF lt(VF a, VF b) { return hn::Lt(a, b); }
+    static MF gt(VF a, VF b) { return hn::Gt(a, b); }
+    static MF is_inf(VF a) { return hn::IsInf(a); }
+    static VF select(MF m, VF a, VF b) { return hn::IfThenElse(m, a, b); }
+};
+
+// The per-path bounce's rules compiled for this target (see rules.inc).
+namespace path_rules {
+#include "integrator/path/rules.inc"
+}  // namespace path_rules
+
 // offset_ray_origin (geometry/interaction.h) per lane: p offset along n by the error bound, on the
 // side of w, then rounded away from the surface (next_float_up/down as integer steps).
 template <class D, class VF>
@@ -141,12 +163,8 @@ void DiffuseStep(size_t n, const DiffuseStepBatch& b) {
             hn::StoreU(o[k], d, b.o[k] + i);
             hn::StoreU(w[k], d, b.d[k] + i);
         }
-        // Russian roulette: q = min(max_component(beta) eta_scale, 0.95) as std::min and std::max.
-        const VF m12 = sel(hn::Lt(beta[1], beta[2]), beta[2], beta[1]);
-        const VF mx = sel(hn::Lt(beta[0], m12), m12, beta[0]);
-        const VF qa = hn::Mul(mx, ld(b.eta_scale));
-        const VF c95 = hn::Set(d, 0.95f);
-        const VF q = sel(hn::Lt(c95, qa), c95, qa);
+        // Russian roulette, by the per-path bounce's rule.
+        const VF q = path_rules::roulette_survival(LaneOps<decltype(d)>{d}, beta[0], beta[1], beta[2], ld(b.eta_scale));
         if (b.rr) {
             ok = hn::And(ok, hn::Not(hn::Ge(ld(b.u_rr), q)));
             for (int k = 0; k < 3; ++k) beta[k] = hn::Div(beta[k], q);
@@ -224,15 +242,11 @@ void AreaLightStep(size_t n, const float* cdf, const float* tri, const float* ra
         VF f[3];
         for (int k = 0; k < 3; ++k) f[k] = hn::Mul(ld(b.albedo[k]), fz);
         ok = hn::And(ok, hn::Not(hn::And(hn::And(hn::Eq(f[0], zero), hn::Eq(f[1], zero)), hn::Eq(f[2], zero))));
-        // power_heuristic(light pdf, bsdf pdf x 1) in MIS mode, else 1; the contribution
-        // beta f Le (1 w / pdf).
-        VF w = one;
-        if (mis) {
-            const VF a2 = hn::Mul(lpdf, lpdf), c2 = hn::Mul(hn::Mul(bpdf, one), hn::Mul(bpdf, one));
-            const VF sum = hn::Add(a2, c2);
-            w = sel(hn::IsInf(a2), one, sel(hn::Gt(sum, zero), hn::Div(a2, sum), zero));
-        }
-        const VF scale = hn::Div(hn::Mul(one, w), lpdf);
+        // The per-path bounce's weight and scale with transmittance 1 (ShadowRequest::contribution
+        // in path/bounce.h): the MIS weight in MIS mode, else 1; the contribution beta f Le (1 w / pdf).
+        const LaneOps<decltype(d)> ops{d};
+        const VF w = mis ? path_rules::light_mis_weight(ops, lpdf, bpdf, one) : one;
+        const VF scale = path_rules::light_scale(ops, one, w, lpdf);
         for (int k = 0; k < 3; ++k) {
             const VF Le = hn::GatherIndex(d, radiance + k, e3);
             hn::StoreU(hn::Mul(hn::Mul(hn::Mul(ld(b.beta[k]), f[k]), Le), scale), d, b.L[k] + i);

@@ -3,7 +3,9 @@
 // the shading, the light sample (area_light_step), the BSDF sample (cosine hemisphere), the
 // throughput update, the next ray (spawn_ray) and Russian roulette. Lane i makes the float
 // operations of the scalar loop (PathIntegrator::Li with shade, DiffuseBsdf::sample, Frame,
-// offset_ray_origin, the roulette) in the same order, so every result is the same bit for bit.
+// offset_ray_origin, the roulette) in the same order, so every result is the same bit for bit. The
+// MIS weight, the light sample's scale and the roulette's survival are the per-path bounce's own
+// rules (path/rules.inc, compiled here per target).
 #include <cstddef>
 #include <cstdint>
 

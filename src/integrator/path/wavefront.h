@@ -7,16 +7,17 @@
 //      hit on the scene's own triangles with a plain, untextured diffuse material takes a lane;
 //   2. the lanes' hit reconstruction in SIMD lanes (hit_soa.h), then per lane emission and the
 //      numbers of this bounce, drawn in Li's order. Every other hit (other materials, analytic
-//      shapes, instances) makes its whole bounce here, per path, as Li does;
+//      shapes, instances) makes its whole bounce here, per path: path_bounce (path/bounce.h), the
+//      function Li runs, its shadow ray queued for stage 4;
 //   3. in SIMD lanes: the shading (frame, wo, albedo), the light samples when the lights are
 //      emissive triangles (the shadow ray and its contribution, computed as if unoccluded; per
 //      path otherwise) and the diffuse step: BSDF sample, throughput, next ray, roulette
 //      (diffuse_step.h);
 //   4. the round's shadow rays; each adds its contribution when unoccluded (the shadow ray's
 //      outcome changes no sampler draw and no throughput, so the path went on before).
-// Each path makes the operations of PathIntegrator::Li (path_impl.h) in the same order, and the
-// film gets the samples in the scalar loop's order: the image is the same bit for bit
-// (tests/test_staged.cpp compares the films on every SIMD target).
+// Each path makes the operations of PathIntegrator::Li (path_impl.h, path/bounce.h) in the same
+// order, and the film gets the samples in the scalar loop's order: the image is the same bit for
+// bit (tests/test_staged.cpp compares the films on every SIMD target).
 //
 // Scope (staged_pass_applies): scenes without masks or textured emitters, any sampler, films
 // without adaptive sampling, AOVs or alpha (any pixel filter). The path pass uses the per-path
@@ -30,14 +31,11 @@
 
 namespace candela {
 
+// A path of the staged loop: its state (path/bounce.h), its sampler, and this round's light
+// sample: its shadow ray and what it adds when nothing is in the way.
 template <class S>
-struct StagedPath {
-    Ray ray;
-    vec3 L{0.f}, beta{1.f}, prev_p{0.f};
-    float prev_pdf = 0.f, eta_scale = 1.f;
-    bool after_delta = true;
+struct StagedPath : PathState {
     S sampler;
-    // This round's light sample: its shadow ray and what it adds when nothing is in the way.
     Ray shadow;
     vec3 shadow_L{0.f};
 };
@@ -95,6 +93,14 @@ struct StagedScratch {
     }
 };
 
+// A light sample's shadow ray kept for the end of the round, with its contribution when unoccluded
+// (no masks in the staged loop's scope: T is 1 or 0).
+template <class S>
+inline void queue_shadow(StagedPath<S>& p, const ShadowRequest& r) {
+    p.shadow = r.ray;
+    p.shadow_L = r.contribution(1.f);
+}
+
 // Runs the paths whose indices are in `live` (all at depth 0; emptied on return) to their end.
 // Scenes without masks (staged_pass_applies).
 template <class S>
@@ -108,6 +114,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
     x.reserve((paths.size() + kAlign - 1) / kAlign * kAlign);
     ShadingT<true> sh;   // a lane's shading, when its light sample is made per path
     ShadingT<false> shg; // another hit's
+    const BounceSettings bset(sc, false);  // no masks in the scope
     // Every live path is at the same depth: they start together and each round is one bounce.
     for (int depth = 0; !live.empty(); ++depth) {
         x.next.clear();
@@ -121,8 +128,7 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             Hit hit;
             ++stats.rays;
             if (!sc.accel->intersect(p.ray, hit)) {
-                if (sc.lights.has_infinite() && !(depth == 0 && st.integrator.hide_emitters))
-                    add_infinite(sc.lights, glm::normalize(p.ray.d), p.beta, p.after_delta, mode, p.prev_pdf, p.L);
+                path_escaped(sc, p, depth);
                 continue;
             }
             if (depth == 0 && st.integrator.hide_emitters && !skip_area_emitters(sc, p.ray, hit, stats)) continue;
@@ -201,51 +207,17 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
             x.u[1][q] = u2.y;
             x.u_rr[q] = rr ? p.sampler.next_1d() : 0.f;
         }
-        // Stage 2c: every other hit makes its whole bounce here, as Li does, but for its shadow
-        // ray (traced with the round's; no masks: its transmittance is 0 or 1).
+        // Stage 2c: every other hit makes its whole bounce here (path_bounce, as Li), but for its
+        // shadow ray, traced with the round's (no masks: its transmittance is 0 or 1).
         for (const auto& [i, hit] : x.other) {
             StagedPath<S>& p = paths[i];
             SurfaceInteraction si = sc.interaction(hit);
-            const vec3 wo_world = -glm::normalize(p.ray.d);
-            add_emission(sc, hit, si, wo_world, p.beta, p.after_delta, mode, p.prev_p, p.prev_pdf, p.L);
-            if (!bounce) continue;
-            shade<false>(sc, hit, si, wo_world, shg);
-            if (mode != SamplingMode::Bsdf && have_lights && shg.has_smooth_component()) {
-                const float ul = p.sampler.next_1d();
-                const vec2 up = p.sampler.next_2d();
-                LightSample ls;
-                if (sc.lights.sample_li(si.p, ul, up, ls)) {
-                    const BsdfEval e = shg.eval_pdf(shg.frame.to_local(ls.wi));
-                    if (!is_black(e.f)) {
-                        p.shadow = shadow_ray(si, ls);
-                        ++stats.rays;
-                        const float T = 1.f;
-                        const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
-                        p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
-                        x.shadowed.push_back(i);
-                    }
-                }
-            } else if (mode != SamplingMode::Bsdf) {
-                p.sampler.next_1d();
-                p.sampler.next_2d();
-            }
-            const float u1 = p.sampler.next_1d();
-            const vec2 u2 = p.sampler.next_2d();
-            const std::optional<BsdfSample> bs = shg.sample(u1, u2);
-            if (!bs || !(bs->pdf > 0.f)) continue;
-            p.beta *= bs->weight();
-            if (is_black(p.beta)) continue;
-            p.eta_scale *= sqr(bs->eta);
-            p.after_delta = bs->delta;
-            p.prev_pdf = bs->pdf;
-            p.prev_p = si.p;
-            p.ray = spawn_ray(si, shg.frame.to_world(bs->wi));
-            if (rr) {
-                const float q = std::min(max_component(p.beta) * p.eta_scale, 0.95f);
-                if (p.sampler.next_1d() >= q) continue;
-                p.beta /= q;
-            }
-            x.next.push_back(i);
+            const BounceResult b =
+                path_bounce<false>(sc, bset, hit, si, depth, p, p.sampler, shg, stats, [&](const ShadowRequest& r) {
+                    queue_shadow(p, r);
+                    x.shadowed.push_back(i);
+                });
+            if (b == BounceResult::Continue) x.next.push_back(i);
         }
         if (!bounce) break;  // no path goes on
         if (nl > 0) {
@@ -299,16 +271,10 @@ void trace_staged(const Scene& sc, const StagedTables& tab, std::vector<StagedPa
                     si.prim = x.lane_hit[q].prim;
                     si.shape = x.shape[q];
                     shade<true>(sc, x.lane_hit[q], si, -glm::normalize(p.ray.d), sh);
-                    LightSample ls;
-                    if (!sc.lights.sample_li(si.p, x.u_l[q], vec2(x.u_lp[0][q], x.u_lp[1][q]), ls)) continue;
-                    const BsdfEval e = sh.eval_pdf(sh.frame.to_local(ls.wi));
-                    if (is_black(e.f)) continue;
-                    p.shadow = shadow_ray(si, ls);
+                    ShadowRequest r;
+                    if (!light_sample(sc, si, sh, p.beta, x.u_l[q], vec2(x.u_lp[0][q], x.u_lp[1][q]), r)) continue;
                     ++stats.rays;
-                    // Li's weight with transmittance T = 1 (no masks): e.pdf * 1 and 1 * w are exact.
-                    const float T = 1.f;
-                    const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * T) : 1.f;
-                    p.shadow_L = p.beta * e.f * ls.Le * (T * w / ls.pdf);
+                    queue_shadow(p, r);
                     x.shadowed.push_back(x.lane_path[q]);
                 }
             }
@@ -385,7 +351,7 @@ PassStats render_tiles_staged(const Scene& scene, Film& film, uint32_t first_sam
         for (int y = tr.y0; y < tr.y1; ++y)
             for (int x = tr.x0; x < tr.x1; ++x)
                 for (int s = s0; s < s1; ++s) {
-                    StagedPath<S> p{Ray(), vec3(0.f), vec3(1.f), vec3(0.f), 0.f, 1.f, true, prototype, Ray(), vec3(0.f)};
+                    StagedPath<S> p{PathState{}, prototype, Ray(), vec3(0.f)};
                     vec2 jitter;
                     p.ray = camera_sample(p.sampler, camera, x, y, first_sample + uint32_t(s), jitter);
                     t.pos.push_back(vec2(float(x), float(y)) + jitter);
@@ -452,32 +418,15 @@ PassStats render_staged_for(const Scene& scene, Film& film, uint32_t first_sampl
 #define CANDELA_STAGED_EXTERN(S)                                                                           \
     extern template PassStats render_staged_for<S>(const Scene&, Film&, uint32_t, int, int,             \
                                                    const std::atomic<bool>*);
-CANDELA_STAGED_EXTERN(StratifiedSampler)
-CANDELA_STAGED_EXTERN(MultijitterSampler)
-CANDELA_STAGED_EXTERN(LdSampler)
-CANDELA_STAGED_EXTERN(SobolSampler)
-CANDELA_STAGED_EXTERN(ZSobolSampler)
-CANDELA_STAGED_EXTERN(OrthogonalSampler)
+CANDELA_FOR_EACH_SAMPLER_COMPILED_APART(CANDELA_STAGED_EXTERN)
 #undef CANDELA_STAGED_EXTERN
 
 inline PassStats render_staged_sampled_pass(const Scene& scene, Film& film, uint32_t first_sample, int spp,
                                             int n_threads, const std::atomic<bool>* cancel) {
-    switch (scene.settings.sampler.type) {
-        case SamplerType::Stratified:
-            return render_staged_for<StratifiedSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Multijitter:
-            return render_staged_for<MultijitterSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::LdSampler:
-            return render_staged_for<LdSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Sobol:
-            return render_staged_for<SobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::ZSobol:
-            return render_staged_for<ZSobolSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Orthogonal:
-            return render_staged_for<OrthogonalSampler>(scene, film, first_sample, spp, n_threads, cancel);
-        case SamplerType::Independent: break;
-    }
-    return render_staged_for<IndependentSampler>(scene, film, first_sample, spp, n_threads, cancel);
+    return visit_sampler_type(scene.settings.sampler.type, [&](auto tag) {
+        using S = typename decltype(tag)::type;
+        return render_staged_for<S>(scene, film, first_sample, spp, n_threads, cancel);
+    });
 }
 
 }  // namespace candela
