@@ -376,7 +376,7 @@ TEST(IntegratorXml, ParametersAndErrors) {
     EXPECT_EQ(s.settings.max_depth, 2);
     s = load("<integrator type=\"moment\"><integrator type=\"aov\"><string name=\"aovs\" value=\"d:depth\"/>"
              "<integrator type=\"volpath\"><integer name=\"max_depth\" value=\"2\"/></integrator></integrator></integrator>");
-    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
+    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Volpath);
     EXPECT_EQ(s.settings.max_depth, 1);
     // The moment channels come last, named after the (unnamed: "_arg_0") integrator it holds.
     ASSERT_EQ(s.settings.integrator.aovs.size(), 2u);
@@ -385,7 +385,7 @@ TEST(IntegratorXml, ParametersAndErrors) {
                                         "m2__arg_0.Z"}));
 
     s = load("<integrator type=\"volpathmis\"><integer name=\"max_depth\" value=\"4\"/></integrator>");
-    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);
+    EXPECT_EQ(s.settings.integrator.type, IntegratorType::Volpath);
     EXPECT_EQ(s.settings.max_depth, 3);
     // The differentiable integrators: Mitsuba's default depth for them is 6 segments, not unbounded.
     s = load("<integrator type=\"prb\"/>");

@@ -78,13 +78,13 @@ TEST(MediaXml, HomogeneousMediumOnShapesAndSensor) {
             <ref name="exterior" id="fog"/>
         </shape>)");
     const Geometry& g = *sc->geometry;
-    ASSERT_EQ(g.media.size(), 2u);
-    EXPECT_EQ(g.media[0].sigma_t, vec3(2.f, 1.f, 4.f));  // sigma_t times scale
-    EXPECT_EQ(g.media[0].albedo, vec3(0.9f, 0.5f, 0.1f));
-    EXPECT_FLOAT_EQ(g.media[0].g, -0.3f);
-    EXPECT_EQ(g.media[1].sigma_t, vec3(2.f));
-    EXPECT_EQ(g.media[1].albedo, vec3(0.75f));  // Mitsuba's default
-    EXPECT_EQ(g.media[1].g, 0.f);
+    ASSERT_EQ(sc->media.size(), 2u);
+    EXPECT_EQ(sc->media[0].sigma_t, vec3(2.f, 1.f, 4.f));  // sigma_t times scale
+    EXPECT_EQ(sc->media[0].albedo, vec3(0.9f, 0.5f, 0.1f));
+    EXPECT_FLOAT_EQ(sc->media[0].g, -0.3f);
+    EXPECT_EQ(sc->media[1].sigma_t, vec3(2.f));
+    EXPECT_EQ(sc->media[1].albedo, vec3(0.75f));  // Mitsuba's default
+    EXPECT_EQ(sc->media[1].g, 0.f);
     EXPECT_EQ(g.camera_medium, 0);
     EXPECT_EQ(g.shapes[0].interior, 0);
     EXPECT_EQ(g.shapes[0].exterior, -1);
@@ -253,7 +253,7 @@ TEST(Volpath, SingleScatteringMatchesNumericalIntegration) {
             <rgb name="albedo" value="0.8, 0.6, 0.9"/><phase type="hg"><float name="g" value="0.5"/></phase></medium>
         <sensor type="perspective"><ref id="air"/></sensor>
         <emitter type="point"><point name="position" x="0" y="0.7" z="1.5"/><rgb name="intensity" value="2"/></emitter>)");
-    const Medium& m = sc->geometry->media[0];
+    const Medium& m = sc->media[0];
     Ray ray;
     ray.o = vec3(0.f);
     ray.d = vec3(0.f, 0.f, 1.f);
@@ -375,7 +375,7 @@ TEST(MediaGrid, DeltaAndRatioTrackingMatchTheTransmittance) {
             <transform name="to_world"><scale x="2" y="1.5" z="1"/><translate x="-1" y="-0.7" z="0"/></transform>
         </volume><float name="scale" value="1"/></medium>
         <sensor type="perspective"><ref id="m"/></sensor>)");
-    const Medium& m = sc->geometry->media[0];
+    const Medium& m = sc->media[0];
     for (vec3 o : {vec3(-2.f, 0.f, 0.5f), vec3(-1.5f, -0.5f, 0.2f)}) {
         Ray ray;
         ray.o = o;
@@ -450,4 +450,55 @@ TEST(Volpath, ThreadCountDoesNotChangeTheImage) {
             }
         EXPECT_GT(sum, 1.0) << name;
     }
+}
+
+// The viewer's edits (SceneParams::media through Scene::with_params, as the panel's edit_medium
+// makes them): an edited medium renders bit for bit as the file that says those values, and an
+// edit of a grid's scale derives its majorant again.
+TEST(Volpath, EditedMediumRendersAsLoaded) {
+    auto render = [](const Scene& sc) {
+        Film f(sc.settings.width, sc.settings.height);
+        configure_film(f, sc.settings);
+        Renderer::render_pass(sc, f, 0, 4, 1);
+        return f.resolve();
+    };
+    auto homogeneous = [](const char* name, const char* sigma, const char* albedo, const char* scale, const char* g) {
+        return scene_from(name, std::string(R"(<integrator type="volpath"/>
+            <sensor type="perspective"><transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor>
+            <emitter type="constant"/>
+            <shape type="sphere"><bsdf type="null"/>
+                <medium type="homogeneous" name="interior"><rgb name="sigma_t" value=")") + sigma +
+                                     R"("/><rgb name="albedo" value=")" + albedo + R"("/><float name="scale" value=")" +
+                                     scale + R"("/><phase type="hg"><float name="g" value=")" + g + R"("/></phase></medium></shape>)");
+    };
+    auto target = homogeneous("edit_target", "1, 2, 3", "0.6, 0.7, 0.8", "1.5", "0.4");
+    auto start = homogeneous("edit_start", "0.5, 0.5, 0.5", "0.9, 0.9, 0.9", "1", "0");
+    ASSERT_NE(render(*target), render(*start));
+    SceneParams p = start->params();
+    p.media[0].sigma_t_base = vec3(1.f, 2.f, 3.f);
+    p.media[0].albedo = vec3(0.6f, 0.7f, 0.8f);
+    p.media[0].scale = 1.5f;
+    p.media[0].g = 0.4f;
+    refresh_medium(p.media[0]);
+    EXPECT_EQ(render(*start->with_params(p)), render(*target));
+    p.media.pop_back();
+    EXPECT_THROW(start->with_params(p), Error);  // the geometry's shapes index the media
+
+    // A grid: the albedo edit as the file's $albedo, the scale edit changes the image and back.
+    const std::string file = std::string(CANDELA_TEST_DATA) + "/scenes/media_hetero.xml";
+    auto grey = build_scene(load_scene(file, {{"res", "16"}, {"albedo", "0.5, 0.5, 0.5"}}));
+    auto as_file = build_scene(load_scene(file, {{"res", "16"}}));
+    SceneParams q = grey->params();
+    q.media[0].albedo = vec3(0.85f, 0.8f, 0.7f);
+    const auto edited = grey->with_params(q);
+    const auto img = render(*edited);
+    EXPECT_EQ(img, render(*as_file));
+    const float scale = q.media[0].scale;
+    q.media[0].scale = scale / 2;
+    refresh_medium(q.media[0]);
+    EXPECT_NE(render(*grey->with_params(q)), img);
+    q.media[0].scale = scale;
+    refresh_medium(q.media[0]);
+    EXPECT_EQ(render(*grey->with_params(q)), img);
 }

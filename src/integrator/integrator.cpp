@@ -17,7 +17,7 @@ std::unique_ptr<Integrator> make_integrator(const Scene& scene) {
         case IntegratorType::Mmlt: return std::make_unique<MmltPass>();
         // Without media volpath is the path tracer (the same image bit for bit, and its speed).
         case IntegratorType::Volpath:
-            if (!scene.geometry->media.empty()) return std::make_unique<VolpathPass>();
+            if (!scene.media.empty()) return std::make_unique<VolpathPass>();
             break;
         case IntegratorType::Path: break;
     }

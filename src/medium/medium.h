@@ -28,7 +28,8 @@ namespace candela {
 
 struct Medium {
     std::string name;      // its id in the scene file, for messages
-    vec3 sigma_t{1.f};     // per unit length, scale applied
+    vec3 sigma_t{1.f};     // per unit length, scale applied (derived: refresh_medium)
+    vec3 sigma_t_base{1.f};  // homogeneous: sigma_t as the file gives it, before scale (what the viewer edits)
     vec3 albedo{0.75f};    // Mitsuba's default
     float g = 0.f;         // 0: isotropic
     // Heterogeneous media only (density non-null): a one-channel density grid, the world-to-grid
@@ -141,8 +142,20 @@ inline float ratio_track(const Medium& m, const Ray& ray, float len, S& sampler)
     return 0.f;
 }
 
-// Why a medium's values are refused (nullptr when valid): the loader's one rule.
+// Derives sigma_t and the majorant from what a file or the viewer sets: sigma_t_base (homogeneous)
+// or the density grid (heterogeneous), times scale.
+inline void refresh_medium(Medium& m) {
+    if (m.heterogeneous()) {
+        m.majorant = m.scale * m.density->max_value;
+        m.sigma_t = vec3(m.majorant);
+    } else {
+        m.sigma_t = m.sigma_t_base * m.scale;
+    }
+}
+
+// Why a medium's values are refused (nullptr when valid): the loader's and the viewer's one rule.
 inline const char* medium_error(const Medium& m) {
+    if (!(m.scale >= 0.f) || !std::isfinite(m.scale)) return "scale must be finite and >= 0";
     for (int c = 0; c < 3; ++c) {
         if (!(m.sigma_t[c] >= 0.f) || !std::isfinite(m.sigma_t[c])) return "sigma_t (times scale) must be finite and >= 0";
         if (!(m.albedo[c] >= 0.f && m.albedo[c] <= 1.f)) return "albedo must lie in [0, 1]";

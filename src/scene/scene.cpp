@@ -157,6 +157,7 @@ Scene::Scene(std::string source_, std::shared_ptr<const Geometry> geometry_, std
       materials(prepared(p.materials)),
       emitters(p.emitters),
       light_params(p.lights),
+      media(p.media),
       warnings(std::move(warnings_)) {}
 
 namespace {
@@ -215,9 +216,9 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
         in.bounds = transform_box(in.to_world, desc.groups[in.group].bounds());
     }
     SceneParams params{desc.camera, desc.settings, std::move(desc.materials), std::move(desc.emitters),
-                       std::move(desc.lights)};
+                       std::move(desc.lights), std::move(desc.media)};
     check_params(desc.source, desc.shapes, params);
-    check_media(desc.source, desc.media_line, desc.media, desc.camera_medium, desc.shapes, params.settings);
+    check_media(desc.source, desc.media_line, params.media, desc.camera_medium, desc.shapes, params.settings);
 
     desc.mesh.compute_face_normals();
     for (ShapeGroup& g : desc.groups) g.mesh.compute_face_normals();
@@ -227,7 +228,6 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
     geometry->analytic = std::move(desc.analytic);
     geometry->groups = std::move(desc.groups);
     geometry->instances = std::move(desc.instances);
-    geometry->media = std::move(desc.media);
     geometry->camera_medium = desc.camera_medium;
     geometry->bounds = geometry->mesh.bounds();
     for (const AnalyticShape& a : geometry->analytic) geometry->bounds.expand(a.bounds());
@@ -253,7 +253,12 @@ std::shared_ptr<const Scene> build_scene(SceneDescription desc, const std::strin
 
 std::shared_ptr<const Scene> Scene::with_params(const SceneParams& p) const {
     check_params(source, shapes, p);
-    check_media(source, 0, geometry->media, geometry->camera_medium, shapes, p.settings);
+    // The media are edited in place (the viewer): their number is the geometry's, as the shapes
+    // index them.
+    if (p.media.size() != media.size())
+        throw Error(source, 0, "the scene has " + std::to_string(media.size()) + " media, the parameters " +
+                                   std::to_string(p.media.size()));
+    check_media(source, 0, p.media, geometry->camera_medium, shapes, p.settings);
     std::shared_ptr<const LightSet> lights_for = light_set;
     if (!same_emitters(emitters, p.emitters) || !same_lights(light_params, p.lights)) {
         auto rebuilt = std::make_shared<LightSet>();

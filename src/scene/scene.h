@@ -53,6 +53,7 @@ struct SceneParams {
     std::vector<Material> materials;
     std::vector<AreaEmitter> emitters;
     std::vector<Light> lights;  // the emitters not on shapes (point, spot, directional, constant)
+    std::vector<Medium> media;  // participating media (Shape::interior/exterior and the camera index them)
 };
 
 // A scene as loaded, before anything is derived from it. Loaders fill it; build_scene consumes it.
@@ -91,8 +92,7 @@ struct Geometry {
     std::vector<AnalyticShape> analytic;
     std::vector<ShapeGroup> groups;
     std::vector<Instance> instances;
-    std::vector<Medium> media;    // participating media (medium/medium.h); empty in most scenes
-    int32_t camera_medium = -1;   // the medium the camera rays start in, or -1
+    int32_t camera_medium = -1;   // the medium the camera rays start in, or -1 (Scene::media)
     AABB bounds;  // world: the scene's own primitives and every instance
 };
 
@@ -118,6 +118,7 @@ public:
     const std::vector<Material> materials;
     const std::vector<AreaEmitter> emitters;
     const std::vector<Light> light_params;  // SceneParams::lights (the light set holds its copy)
+    const std::vector<Medium> media;        // participating media (medium/medium.h); empty in most scenes
     const std::vector<std::string> warnings;
 
     Scene(const Scene&) = delete;
@@ -129,7 +130,7 @@ public:
     // time, the render worker, not the window. Throws Error when `p` does not fit the geometry
     // (another number of materials or emitters, an impossible film size).
     std::shared_ptr<const Scene> with_params(const SceneParams& p) const;
-    SceneParams params() const { return {camera, settings, materials, emitters, light_params}; }
+    SceneParams params() const { return {camera, settings, materials, emitters, light_params, media}; }
 
     // Surface data at a hit (a triangle or an analytic shape, by hit.kind), with the error bound
     // of the point. In an instance (hit.instance set) the group-space interaction is taken to

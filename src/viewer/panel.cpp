@@ -135,6 +135,22 @@ const char* bsdf_type_name(const Bsdf& b) {
     return std::visit([](const auto& x) { return model_name(x); }, b);
 }
 
+bool edit_medium(Medium& m) {
+    bool changed = false;
+    if (!m.heterogeneous()) changed |= drag_positive("sigma_t", m.sigma_t_base, 0.01f);
+    else ImGui::TextDisabled("sigma_t: a grid (%s), times scale", "gridvolume");
+    if (!m.albedo_grid) changed |= reflectance("albedo", m.albedo);
+    else ImGui::TextDisabled("albedo: a grid");
+    if (ImGui::DragFloat("scale", &m.scale, 0.01f, 0.f, 1e6f, "%.4f", ImGuiSliderFlags_AlwaysClamp)) changed = true;
+    if (ImGui::SliderFloat("g", &m.g, -0.99f, 0.99f, "%.3f", ImGuiSliderFlags_AlwaysClamp)) changed = true;
+    if (changed) {
+        m.scale = std::max(m.scale, 0.f);
+        m.albedo = glm::clamp(m.albedo, vec3(0.f), vec3(1.f));
+        refresh_medium(m);
+    }
+    return changed;
+}
+
 bool edit_material(Material& m) {
     bool changed = std::visit([](auto& b) { return edit_bsdf(b); }, m.bsdf);
     // A textured parameter takes its value from the texture at each point: its slider has no effect.

@@ -3,6 +3,7 @@
 // changed a value, so that the caller restarts the render exactly when the image changes.
 #include "bsdf/bsdf.h"
 #include "light/area.h"
+#include "medium/medium.h"
 
 namespace candela {
 
@@ -20,5 +21,10 @@ bool edit_material(Material& m);
 // Radiance of an area light (RGB, may exceed 1).
 bool edit_emitter(AreaEmitter& e);
 bool edit_light(Light& l);  // a top-level emitter's intensity, irradiance or radiance
+
+// A participating medium's sigma_t before scale (homogeneous), albedo (unless a grid gives
+// it), scale and phase g, kept within the values the loader accepts (medium_error); sigma_t and the
+// majorant are derived again (refresh_medium) when one changes.
+bool edit_medium(Medium& m);
 
 }  // namespace candela

@@ -266,6 +266,19 @@ void Viewer::panel() {
         }
     }
 
+    if (!fe_->params().media.empty() && ImGui::CollapsingHeader("Media", ImGuiTreeNodeFlags_DefaultOpen)) {
+        for (size_t i = 0; i < fe_->params().media.size(); ++i) {
+            Medium& m = fe_->params().media[i];
+            ImGui::PushID(int(i) + 200000);
+            if (ImGui::TreeNodeEx("##md", ImGuiTreeNodeFlags_DefaultOpen, "%s  (%s)", m.name.c_str(),
+                                  m.heterogeneous() ? "heterogeneous" : "homogeneous")) {
+                if (edit_medium(m)) fe_->params_changed(viewer_now());
+                ImGui::TreePop();
+            }
+            ImGui::PopID();
+        }
+    }
+
     const bool any_light = !fe_->params().emitters.empty() || !fe_->params().lights.empty();
     if (any_light && ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) {
         for (size_t i = 0; i < fe_->params().emitters.size(); ++i) {

@@ -52,7 +52,7 @@ public:
                           const std::atomic<bool>* cancel) const override;
 };
 
-inline VolpathIntegrator::VolpathIntegrator(const Scene& scene) : scene_(scene), media_(scene.geometry->media) {}
+inline VolpathIntegrator::VolpathIntegrator(const Scene& scene) : scene_(scene), media_(scene.media) {}
 
 // The medium a ray enters leaving the surface at `si` (world geometric normal of the shape, not
 // turned towards the ray) in direction w: Mitsuba's target_medium. Unchanged where the shape names

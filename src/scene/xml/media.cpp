@@ -104,6 +104,8 @@ int32_t load_medium(XmlLoader& L, pugi::xml_node n) {
     m.albedo = al.value;
     const float scale = o.params.get_float("scale", 1.f);
     if (!(scale >= 0.f) || !std::isfinite(scale)) throw o.params.error("scale", "scale must be finite and >= 0");
+    m.sigma_t_base = sigma_t;
+    m.scale = scale;
     m.sigma_t = sigma_t * scale;
     if (heterogeneous) {
         if (!st.grid) throw L.error(n, o.what() + ": candela reads a heterogeneous medium's sigma_t from a gridvolume");
@@ -118,9 +120,7 @@ int32_t load_medium(XmlLoader& L, pugi::xml_node n) {
         if (al.grid)
             for (float v : al.grid->data)
                 if (!(v >= 0.f && v <= 1.f)) throw L.error(n, o.what() + ": the albedo grid has values outside [0, 1]");
-        m.scale = scale;
-        m.majorant = scale * st.grid->max_value;
-        m.sigma_t = vec3(m.majorant);  // checked below like a homogeneous medium's
+        refresh_medium(m);  // sigma_t = the majorant: checked below like a homogeneous medium's
         m.albedo = al.grid ? vec3(0.5f) : m.albedo;
     }
     for (int c = 0; c < 3; ++c) {
