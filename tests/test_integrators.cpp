@@ -387,6 +387,9 @@ TEST(IntegratorXml, ParametersAndErrors) {
     s = load("<integrator type=\"volpathmis\"><integer name=\"max_depth\" value=\"4\"/></integrator>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Volpath);
     EXPECT_EQ(s.settings.max_depth, 3);
+    EXPECT_TRUE(s.settings.integrator.spectral_mis);
+    s = load("<integrator type=\"volpath\"/>");
+    EXPECT_FALSE(s.settings.integrator.spectral_mis);
     // The differentiable integrators: Mitsuba's default depth for them is 6 segments, not unbounded.
     s = load("<integrator type=\"prb\"/>");
     EXPECT_EQ(s.settings.integrator.type, IntegratorType::Path);

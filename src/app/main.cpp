@@ -57,13 +57,14 @@ int main(int argc, char** argv) {
     app.add_option("-D", defines, "Scene parameter name=value (overrides <default> in XML scenes)")->allow_extra_args(false);
     std::string integrator;
     auto* i_opt = app.add_option("--integrator", integrator,
-                                 "Integrator: path (the path tracer), direct (direct lighting), ptracer (light\n"
-                                 "tracing: light paths splatted through the camera, Mitsuba's ptracer), bdpt\n"
-                                 "(bidirectional path tracing, every (s, t) strategy, MIS) or pssmlt (primary-sample-space\n"
+                                 "Integrator: path (the path tracer), volpath and volpathmis (participating media,\n"
+                                 "docs/media.md), direct (direct lighting), ptracer (light tracing: light paths\n"
+                                 "splatted through the camera, Mitsuba's ptracer), bdpt (bidirectional path tracing,\n"
+                                 "every (s, t) strategy, MIS) or pssmlt (primary-sample-space\n"
                                  "Metropolis over the path tracer) or mmlt (multiplexed Metropolis over BDPT; for both\n"
                                  "the sample count is mutations per pixel, docs/mlt.md);\n"
                                  "replaces the scene's <integrator> type, keeping its depths and hide_emitters")
-                      ->check(CLI::IsMember({"path", "volpath", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
+                      ->check(CLI::IsMember({"path", "volpath", "volpathmis", "direct", "ptracer", "bdpt", "pssmlt", "mmlt"}));
     auto* m_opt = app.add_option("--sampling", sampling,
                                  "The path tracer's emission sampling (path, pssmlt): light, bsdf or mis (default mis)");
     auto* sampler_opt = app.add_option("--sampler", sampler_name,
@@ -140,7 +141,10 @@ int main(int argc, char** argv) {
         if (*m_opt) ov.sampling = parse_sampling_mode(sampling);
         if (*sampler_opt) ov.sampler = parse_sampler_name(sampler_name);
         if (*count_opt) ov.sample_count = sample_count;
-        if (*i_opt) ov.integrator = parse_integrator_type(integrator);
+        if (*i_opt) {
+            ov.integrator = parse_integrator_type(integrator);
+            ov.spectral_mis = integrator == "volpathmis";
+        }
         if (*dq_opt) parse_denoise_quality(denoise_quality, opt.denoise_quality);
         ov.denoise_aux = opt.denoise || aov_layers;
         ov.denoise_box_filter = opt.denoise;

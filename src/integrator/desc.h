@@ -62,6 +62,9 @@ struct IntegratorDesc {
     // Camera rays pass through area emitters (Mitsuba 3's hide_emitters: skip_area_emitters on the
     // first segment), so that an emitter in view shows what lies behind it.
     bool hide_emitters = false;
+    // volpath: Mitsuba's volpathmis, spectral MIS over the distance-sampling channel
+    // (integrator/volpath/volpath.h). No effect in a scene without media.
+    bool spectral_mis = false;
     // direct: samples per shading point of each strategy, combined by the power heuristic with the
     // sample counts in the weights (Mitsuba's direct.cpp).
     int emitter_samples = 1, bsdf_samples = 1;

@@ -31,6 +31,7 @@ void apply_overrides(RenderSettings& st, const SceneOverrides& ov) {
         // Only the type changes: the scene's depths and hide_emitters stay (a direct scene keeps
         // its max depth 2).
         st.integrator.type = *ov.integrator;
+        st.integrator.spectral_mis = ov.spectral_mis;
         if (!reads(*ov.integrator).aovs && !st.integrator.aovs.empty())
             throw Error(std::string("--integrator ") + integrator_type_name(*ov.integrator) +
                         ": the scene's aov or moment integrator needs camera rays per pixel, which it does not trace");
@@ -115,7 +116,8 @@ std::string integrator_summary(const RenderSettings& st) {
     if (c.max_depth) add("max_depth " + std::to_string(max_depth_to_mitsuba(st.max_depth)));
     if (c.rr_depth) add("rr_depth " + std::to_string(st.rr_depth));
     if (c.sampling) add(sampling_mode_name(st.sampling));
-    return std::string(integrator_type_name(st.integrator.type)) + (s.empty() ? "" : " (" + s + ")");
+    const bool mis = st.integrator.type == IntegratorType::Volpath && st.integrator.spectral_mis;
+    return std::string(mis ? "volpathmis" : integrator_type_name(st.integrator.type)) + (s.empty() ? "" : " (" + s + ")");
 }
 
 IntegratorType parse_integrator_type(const std::string& s) {
@@ -125,8 +127,8 @@ IntegratorType parse_integrator_type(const std::string& s) {
     if (s == "bdpt") return IntegratorType::Bdpt;
     if (s == "pssmlt") return IntegratorType::Pssmlt;
     if (s == "mmlt") return IntegratorType::Mmlt;
-    if (s == "volpath") return IntegratorType::Volpath;
-    throw Error("unknown integrator '" + s + "' (expected path, volpath, direct, ptracer, bdpt, pssmlt or mmlt)");
+    if (s == "volpath" || s == "volpathmis") return IntegratorType::Volpath;  // SceneOverrides::spectral_mis
+    throw Error("unknown integrator '" + s + "' (expected path, volpath, volpathmis, direct, ptracer, bdpt, pssmlt or mmlt)");
 }
 
 const char* integrator_type_name(IntegratorType t) {

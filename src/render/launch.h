@@ -28,6 +28,7 @@ struct SceneOverrides {
     std::optional<SamplerType> sampler;  // --sampler (jitter keeps the scene's)
     std::optional<int> sample_count;     // --sample-count: the scene's sample_count
     std::optional<IntegratorType> integrator;  // --integrator: replaces the scene's <integrator>
+    bool spectral_mis = false;                 // --integrator volpathmis (volpath with spectral MIS)
     std::string accel = "auto";
     // --denoise, --aov: render the denoiser's auxiliary layers (add_denoise_aovs) when the
     // integrator traces camera paths per pixel (path, direct); the others have none to follow, and
@@ -60,7 +61,7 @@ void check_run_features(const RenderSettings& st, const RunFeatures& f);
 std::string integrator_summary(const RenderSettings& st);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
-IntegratorType parse_integrator_type(const std::string& s);  // path | direct | ptracer | bdpt | pssmlt | mmlt
+IntegratorType parse_integrator_type(const std::string& s);  // path | volpath | volpathmis | direct | ptracer | bdpt | pssmlt | mmlt
 const char* integrator_type_name(IntegratorType t);
 const char* sampling_mode_name(SamplingMode m);
 // --sampler NAME: a sampler_type_name; unknown names are errors.

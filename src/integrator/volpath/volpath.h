@@ -19,6 +19,16 @@
 // segment once more than rr_depth scattering events were made, with survival
 // min(max(beta) eta^2, 0.95); max_depth counts scattering events (surface and medium) as Mitsuba's.
 // Null surfaces (and masks, with probability 1 - opacity) are crossed without a scattering event.
+//
+// Spectral MIS (Mitsuba's volpathmis; IntegratorDesc::spectral_mis). The same path, but its
+// contribution is weighted by the balance heuristic over the three channels that could have
+// sampled its distances: f / ((p_0 + p_1 + p_2) / 3), p_i the path's density had channel i been
+// chosen (the product of its distance densities), instead of f / p_c. The loop keeps beta = f / p_c
+// as above and ratio = p / p_c (per channel), both divided by max(ratio) at each step (a common
+// factor, so that neither overflows); the throughput is beta / mean(ratio). A grey medium, a
+// heterogeneous one (grey extinction) or no medium leave ratio at 1: the same image as volpath.
+// Light sampling and its MIS with the phase function and the BSDF are volpath's (Mitsuba also
+// puts the distance densities into that MIS weight: the same expectation).
 #include "integrator/integrator.h"
 #include "integrator/path.h"
 
@@ -119,7 +129,11 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
     // The channel whose density samples distances (Mitsuba: min(3 u, 2)).
     const int channel = std::min(int(sampler.next_1d() * 3.f), 2);
     int32_t medium = sc.geometry->camera_medium;
+    const bool spectral_mis = st.integrator.spectral_mis;
     vec3 L(0.f), beta(1.f);
+    vec3 ratio(1.f);            // spectral MIS: the channels' path densities over the chosen one's
+    // The throughput each contribution is weighted by (the balance heuristic under spectral MIS).
+    auto throughput = [&]() { return spectral_mis ? beta * (3.f / (ratio.x + ratio.y + ratio.z)) : beta; };
     float eta = 1.f;            // product of the sampled BSDFs' eta (Russian roulette uses eta^2)
     int depth = 0;              // scattering events so far (surface and medium; not null crossings)
     bool after_delta = true;    // emission counts fully: camera rays, delta bounces
@@ -133,7 +147,7 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         // Russian roulette, then the depth limit (Mitsuba's loop head).
         if (is_black(beta)) break;
         if (depth > st.rr_depth) {
-            const float q = std::min(max_component(beta) * eta * eta, 0.95f);
+            const float q = std::min(max_component(throughput()) * eta * eta, 0.95f);
             if (sampler.next_1d() >= q) break;
             beta /= q;
         }
@@ -158,9 +172,18 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                 const vec3 tr = transmittance(m, scatter ? t : t_surface);
                 if (scatter) {
                     beta *= m.sigma_s() * tr / (m.sigma_t[channel] * tr[channel]);
+                    if (spectral_mis) ratio *= m.sigma_t * tr / (m.sigma_t[channel] * tr[channel]);
                 } else {
                     if (!(tr[channel] > 0.f)) break;
                     beta *= tr / tr[channel];
+                    if (spectral_mis) ratio *= tr / tr[channel];
+                }
+                if (spectral_mis) {
+                    // The chosen channel's entry is unchanged by the step, so the maximum is > 0.
+                    const float s = max_component(ratio);
+                    if (!(s > 0.f && s < kInfinity)) break;  // a density that underflowed: no path
+                    ratio /= s;
+                    beta /= s;
                 }
             }
             if (scatter) {
@@ -188,7 +211,7 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                         if (!is_black(T)) {
                             const float w =
                                 mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, ph * surface_T) : 1.f;
-                            L += beta * ls.Le * T * (ph * w / ls.pdf);
+                            L += throughput() * ls.Le * T * (ph * w / ls.pdf);
                         }
                     }
                 }
@@ -206,14 +229,14 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
         if (!found) {
             // Escaped: the infinite lights (hidden from the camera by hide_emitters).
             if (sc.lights.has_infinite() && !(depth == 0 && hide))
-                add_infinite(sc.lights, ray.d, beta, after_delta || depth == 0, mode, prev_pdf, L);
+                add_infinite(sc.lights, ray.d, throughput(), after_delta || depth == 0, mode, prev_pdf, L);
             break;
         }
         SurfaceInteraction si = sc.interaction(hit);
         const Shape& shape = sc.shapes[si.shape];
         const vec3 ng = si.ng;  // the shape's side, before shade() turns it
         const vec3 wo_world = -ray.d;
-        if (!(depth == 0 && hide)) add_emission(sc, hit, si, wo_world, beta, after_delta || depth == 0, mode, prev_p, prev_pdf, L);
+        if (!(depth == 0 && hide)) add_emission(sc, hit, si, wo_world, throughput(), after_delta || depth == 0, mode, prev_p, prev_pdf, L);
 
         const Material& mat = sc.materials[shape.material];
         if (mat.masked) {
@@ -245,7 +268,7 @@ vec3 VolpathIntegrator::Li(Ray ray, S& sampler, PathStats& stats) const {
                                                         surface_T, sampler, stats.rays);
                     if (!is_black(T)) {
                         const float w = mode == SamplingMode::Mis && !ls.delta ? power_heuristic(ls.pdf, e.pdf * surface_T) : 1.f;
-                        L += beta * e.f * ls.Le * T * (w / ls.pdf);
+                        L += throughput() * e.f * ls.Le * T * (w / ls.pdf);
                     }
                 }
             }

@@ -79,10 +79,11 @@ void read_projective(const ParamSet& p) {
 IntegratorRole read_integrator(const std::string& type, const ParamSet& p, RenderSettings& st, int line) {
     IntegratorDesc& d = st.integrator;
     if (type == "path" || type == "volpath" || type == "volpathmis") {
-        // volpath (and volpathmis, rendered as volpath: docs/media.md) renders media
-        // (integrator/volpath/); in a scene without media it is the path tracer, bit for bit.
+        // volpath and volpathmis (volpath with spectral MIS) render media (integrator/volpath/);
+        // in a scene without media they are the path tracer, bit for bit.
         read_depths(p, st);
         d.type = type == "path" ? IntegratorType::Path : IntegratorType::Volpath;
+        d.spectral_mis = type == "volpathmis";
         d.hide_emitters = p.get_bool("hide_emitters", false);
         p.report_unused();
         return IntegratorRole::Renders;
