@@ -221,7 +221,8 @@ TEST(Volpath, SlabTransmittanceIsExponential) {
 // The chromaticity is mild (sigma_t 0.6, 0.8, 1): with one channel's density for all three, the
 // weight of a denser channel per scattering event has a second moment above 1 when the channels
 // differ a lot (sigma_t 0.5, 1, 2: channel 2's estimate has a heavy tail, 0.976 +- 0.005 at 400k
-// samples, measured), as in Mitsuba's volpath, whose estimator this is (docs/media.md).
+// samples, measured), as in Mitsuba's volpath, whose estimator this is (docs/media.md); volpathmis
+// is tested there (Volpathmis.WhiteFurnaceInAStronglyChromaticMedium).
 TEST(Volpath, WhiteFurnaceInAnAlbedoOneMedium) {
     auto sc = scene_from("furnace", std::string(kVolpath) + R"(
         <medium type="homogeneous" id="white"><rgb name="sigma_t" value="0.3, 0.4, 0.5"/><float name="scale" value="2"/>

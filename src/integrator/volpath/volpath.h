@@ -27,8 +27,8 @@
 // as above and ratio = p / p_c (per channel), both divided by max(ratio) at each step (a common
 // factor, so that neither overflows); the throughput is beta / mean(ratio). A grey medium, a
 // heterogeneous one (grey extinction) or no medium leave ratio at 1: the same image as volpath.
-// Light sampling and its MIS with the phase function and the BSDF are volpath's (Mitsuba also
-// puts the distance densities into that MIS weight: the same expectation).
+// Light sampling and its MIS with the phase function and the BSDF are volpath's (Mitsuba's
+// volpathmis weighs them by one balance heuristic over techniques and channels: the same expectation).
 #include "integrator/integrator.h"
 #include "integrator/path.h"
 
