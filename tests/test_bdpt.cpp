@@ -404,29 +404,7 @@ TEST(Bdpt, FilteredSplatsAgreeWithPathAtSharpEdges) { expect_filtered_splats_agr
 
 // Under the box filter (the built-in Cornell box's) and the gaussian (camera samples and splats
 // both filtered), at 1, 2 and 3 threads.
-TEST(Bdpt, SameFilmAtAnyThreadCountAndPassSplit) {
-    auto base = cornell(20);
-    for (const FilterDesc& f : {box_filter(), gaussian_filter()}) {
-        SCOPED_TRACE(filter_name(f.type));
-        SceneParams p = base->params();
-        p.settings.integrator.type = IntegratorType::Bdpt;
-        p.settings.max_depth = 4;
-        p.settings.filter = f;
-        auto sc = base->with_params(p);
-        Film a(20, 20), b(20, 20), c(20, 20), d(20, 20);
-        Renderer::render_pass(*sc, a, 0, 4, 1);
-        Renderer::render_pass(*sc, b, 0, 4, 2);
-        for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
-        Renderer::render_pass(*sc, d, 0, 4, 3);
-        ASSERT_FALSE(a.splat_sums().empty());
-        EXPECT_EQ(a.splat_paths(), 20u * 20u * 4u);
-        for (const Film* o : {&b, &c, &d}) {
-            EXPECT_EQ(std::memcmp(a.splat_sums().data(), o->splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
-            EXPECT_EQ(a.resolve(), o->resolve());
-        }
-        EXPECT_EQ(a.sample_count(3, 5), 4u);
-    }
-}
+TEST(Bdpt, SameFilmAtAnyThreadCountAndPassSplit) { expect_splat_film_deterministic(*cornell(20), 20, IntegratorType::Bdpt, 4); }
 
 TEST(Bdpt, StrategyImagesSumToTheImage) {
     auto base = cornell(12);

@@ -147,25 +147,7 @@ TEST(Ptracer, Furnace) {
 // over bands of rows shared out to the threads (Film::add_splats): 1, 2 and 3 threads.
 TEST(Ptracer, SameFilmAtAnyThreadCountAndPassSplit) {
     auto base = cornell(20);
-    for (const FilterDesc& f : {box_filter(), gaussian_filter()}) {
-        SCOPED_TRACE(filter_name(f.type));
-        SceneParams p = base->params();
-        p.settings.integrator.type = IntegratorType::Ptracer;
-        p.settings.filter = f;
-        auto sc = base->with_params(p);
-        Film a(20, 20), b(20, 20), c(20, 20), d(20, 20);
-        Renderer::render_pass(*sc, a, 0, 4, 1);
-        Renderer::render_pass(*sc, b, 0, 4, 2);
-        for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
-        Renderer::render_pass(*sc, d, 0, 4, 3);
-        ASSERT_FALSE(a.splat_sums().empty());
-        EXPECT_EQ(a.splat_paths(), 20u * 20u * 4u);
-        for (const Film* o : {&b, &c, &d}) {
-            EXPECT_EQ(std::memcmp(a.splat_sums().data(), o->splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
-            EXPECT_EQ(a.resolve(), o->resolve());
-        }
-        EXPECT_EQ(a.sample_count(3, 5), 4u);
-    }
+    expect_splat_film_deterministic(*base, 20, IntegratorType::Ptracer, base->settings.max_depth);
 }
 
 TEST(Ptracer, CheckpointAndResumeKeepTheSplats) {

@@ -182,6 +182,29 @@ SceneDescription lit_edge_description(int res) {
     return d;
 }
 
+void expect_splat_film_deterministic(const Scene& base, int res, IntegratorType type, int max_depth) {
+    for (const FilterDesc& f : {box_filter(), gaussian_filter()}) {
+        SCOPED_TRACE(filter_name(f.type));
+        SceneParams p = base.params();
+        p.settings.integrator.type = type;
+        p.settings.max_depth = max_depth;
+        p.settings.filter = f;
+        auto sc = base.with_params(p);
+        Film a(res, res), b(res, res), c(res, res), d(res, res);
+        Renderer::render_pass(*sc, a, 0, 4, 1);
+        Renderer::render_pass(*sc, b, 0, 4, 2);
+        for (uint32_t s = 0; s < 4; ++s) Renderer::render_pass(*sc, c, s, 1, 2);
+        Renderer::render_pass(*sc, d, 0, 4, 3);
+        ASSERT_FALSE(a.splat_sums().empty());
+        EXPECT_EQ(a.splat_paths(), uint64_t(res) * uint64_t(res) * 4u);
+        for (const Film* o : {&b, &c, &d}) {
+            EXPECT_EQ(std::memcmp(a.splat_sums().data(), o->splat_sums().data(), a.splat_sums().size() * sizeof(dvec3)), 0);
+            EXPECT_EQ(a.resolve(), o->resolve());
+        }
+        EXPECT_EQ(a.sample_count(3, 5), 4u);
+    }
+}
+
 void expect_filtered_splats_agree(IntegratorType type, int spp, uint64_t seed_base) {
     auto sc = build_scene(lit_edge_description(16), "auto");
     const FilterDesc filters[] = {gaussian_filter(), mitchell_filter()};

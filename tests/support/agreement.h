@@ -80,4 +80,9 @@ SceneDescription lit_edge_description(int res);
 // the block test (the filtered edges spill into the blocks outside the lamp).
 void expect_filtered_splats_agree(IntegratorType type, int spp, uint64_t seed_base);
 
+// A splatting integrator (`type`, max_depth scattering events) on `base` (res x res) under the box
+// and the gaussian filter: the same film and splat sums bit for bit at 1, 2 and 3 threads and when
+// the pass is split in four; splats made, one path per pixel sample.
+void expect_splat_film_deterministic(const Scene& base, int res, IntegratorType type, int max_depth);
+
 }  // namespace candela::test
