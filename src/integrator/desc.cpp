@@ -2,6 +2,19 @@
 
 namespace candela {
 
+const char* integrator_type_name(IntegratorType t) {
+    switch (t) {
+        case IntegratorType::Direct: return "direct";
+        case IntegratorType::Ptracer: return "ptracer";
+        case IntegratorType::Bdpt: return "bdpt";
+        case IntegratorType::Pssmlt: return "pssmlt";
+        case IntegratorType::Mmlt: return "mmlt";
+        case IntegratorType::Volpath: return "volpath";
+        default: return "path";
+    }
+}
+
+
 int aov_channel_count(AovType t) {
     switch (t) {
         case AovType::Depth:

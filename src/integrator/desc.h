@@ -73,6 +73,9 @@ struct IntegratorDesc {
     std::vector<AovSpec> aovs;
 };
 
+// The integrator's name in files and on the command line ("path", "volpath", ...).
+const char* integrator_type_name(IntegratorType t);
+
 // Number of film channels and their EXR names ("dd.T", "nn.X", ...), in order.
 int aov_channel_count(AovType t);
 int aov_channel_count(const std::vector<AovSpec>& aovs);

@@ -131,18 +131,6 @@ IntegratorType parse_integrator_type(const std::string& s) {
     throw Error("unknown integrator '" + s + "' (expected path, volpath, volpathmis, direct, ptracer, bdpt, pssmlt or mmlt)");
 }
 
-const char* integrator_type_name(IntegratorType t) {
-    switch (t) {
-        case IntegratorType::Direct: return "direct";
-        case IntegratorType::Ptracer: return "ptracer";
-        case IntegratorType::Bdpt: return "bdpt";
-        case IntegratorType::Pssmlt: return "pssmlt";
-        case IntegratorType::Mmlt: return "mmlt";
-        case IntegratorType::Volpath: return "volpath";
-        default: return "path";
-    }
-}
-
 SamplingMode parse_sampling_mode(const std::string& s) {
     if (s == "light") return SamplingMode::Light;
     if (s == "bsdf") return SamplingMode::Bsdf;

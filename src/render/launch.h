@@ -62,7 +62,6 @@ std::string integrator_summary(const RenderSettings& st);
 
 SamplingMode parse_sampling_mode(const std::string& s);  // light | bsdf | mis
 IntegratorType parse_integrator_type(const std::string& s);  // path | volpath | volpathmis | direct | ptracer | bdpt | pssmlt | mmlt
-const char* integrator_type_name(IntegratorType t);
 const char* sampling_mode_name(SamplingMode m);
 // --sampler NAME: a sampler_type_name; unknown names are errors.
 SamplerType parse_sampler_name(const std::string& s);

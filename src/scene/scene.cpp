@@ -4,7 +4,7 @@
 #include "accel/with_analytic.h"
 #include "film/film.h"
 #include "integrator/caps.h"
-#include "render/launch.h"  // integrator_type_name
+#include "integrator/desc.h"  // integrator_type_name
 
 namespace candela {
 
